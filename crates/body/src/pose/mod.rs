@@ -1,0 +1,29 @@
+//! Pose sources: CMU-style motion files (ASF/AMC and BVH), retargeting onto a shaped
+//! [`Rig`](crate::rig::Rig), and a seeded procedural pose generator.
+//!
+//! Units inside are metres and radians; degrees and file length units appear only at file
+//! boundaries. The world is garnet's: Y up, the body facing +Z, its left side at +X.
+
+mod amc;
+mod asf;
+mod asf_fk;
+mod bvh;
+mod bvh_write;
+pub mod cmu;
+mod error;
+pub mod euler;
+mod retarget;
+mod source;
+pub mod synthetic;
+
+pub use amc::Amc;
+pub use asf::{Asf, AsfBone, AsfRoot, AsfUnits, Dof};
+pub use asf_fk::AsfPose;
+pub use bvh::{Bvh, BvhChannel, BvhJoint};
+pub use bvh_write::{bvh_string, save_bvh, BvhWriteOptions};
+pub use error::PoseError;
+pub use retarget::{
+    retarget, retarget_rotations, retarget_translation, rig_leg_length, Clip, ClipData,
+    RetargetOptions,
+};
+pub use source::{SourceFrame, SourceSkeleton};

@@ -1,0 +1,196 @@
+//! Retargeting a motion source's frame onto a shaped [`Rig`]: every rig bone takes the
+//! world-space direction of the source bone of the same name.
+//!
+//! For a rig bone `b` driven by source bone `s`: `G_s` is the source bone's world
+//! rotation relative to its rest, `a_s` its rest direction, `d_b` the rig bone's rest
+//! direction, `O_b` the smallest rotation taking `d_b` to `a_s`, and the rig bone's world
+//! delta is `D_b = G_s * O_b`, so that `D_b d_b = G_s a_s`. The root takes `G_root`
+//! directly; rig bones without a source bone follow their parent.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use glam::{DQuat, DVec3, Quat, Vec3};
+
+use super::amc::Amc;
+use super::asf::Asf;
+use super::bvh::Bvh;
+use super::error::PoseError;
+use super::source::{SourceFrame, SourceSkeleton};
+use crate::rig::{Pose, Rig};
+
+/// Options of retargeting.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RetargetOptions {
+    /// Keep the root's horizontal (X, Z) motion; by default it is removed so the body
+    /// stays over the origin.
+    pub keep_horizontal_translation: bool,
+}
+
+/// World rotation deltas `[B]` of every rig bone for one source frame (see the module
+/// documentation).
+pub fn retarget_rotations(rig: &Rig, skeleton: &SourceSkeleton, frame: &SourceFrame) -> Result<Vec<Quat>, PoseError> {
+    if rig.is_empty() {
+        return Err(PoseError::Rig("the rig has no bones".into()));
+    }
+    if frame.world.len() != skeleton.names.len() || skeleton.rest_vectors.len() != skeleton.names.len() {
+        return Err(PoseError::Invalid(format!(
+            "source frame has {} rotations for {} bones",
+            frame.world.len(),
+            skeleton.names.len()
+        )));
+    }
+    let by_name: HashMap<&str, usize> = skeleton
+        .names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| (n.as_str(), i))
+        .collect();
+    let root_g = frame.world.get(skeleton.root).copied().unwrap_or(DQuat::IDENTITY);
+    let mut deltas: Vec<Quat> = Vec::with_capacity(rig.len());
+    for bone in &rig.bones {
+        let source = by_name.get(bone.name.as_str()).copied();
+        let d = match (bone.parent, source) {
+            (None, s) => s.map_or(root_g, |s| frame.world[s]),
+            (Some(_), Some(s)) => {
+                let a = skeleton.rest_vectors[s];
+                let d = (bone.tail - bone.head).as_dvec3();
+                let g = frame.world[s];
+                if a.length() > 1e-9 && d.length() > 1e-9 {
+                    g * DQuat::from_rotation_arc(d.normalize(), a.normalize())
+                } else {
+                    g
+                }
+            }
+            (Some(p), None) => deltas[p].as_dquat(),
+        };
+        deltas.push(d.normalize().as_quat());
+    }
+    Ok(deltas)
+}
+
+/// Hip-to-ankle length of a rig (thigh plus shin, mean of both legs), metres; falls back
+/// to the root's height above the lowest joint.
+pub fn rig_leg_length(rig: &Rig) -> f32 {
+    let len = |n: &str| rig.index(n).map(|i| (rig.bones[i].tail - rig.bones[i].head).length());
+    let legs: Vec<f32> = [("LeftUpLeg", "LeftLeg"), ("RightUpLeg", "RightLeg")]
+        .iter()
+        .filter_map(|(a, b)| Some(len(a)? + len(b)?))
+        .collect();
+    if legs.is_empty() {
+        let lowest = rig.bones.iter().flat_map(|b| [b.head.y, b.tail.y]).fold(f32::INFINITY, f32::min);
+        rig.bones.first().map_or(0.0, |b| b.head.y - lowest)
+    } else {
+        legs.iter().sum::<f32>() / legs.len() as f32
+    }
+}
+
+/// The rig's root translation for a source frame: the source root position scaled by the
+/// ratio of leg lengths, its height taken relative to the source's standing rest root
+/// height (so a standing source keeps the rig's feet on its floor), horizontal motion
+/// kept only if asked.
+pub fn retarget_translation(rig: &Rig, skeleton: &SourceSkeleton, frame: &SourceFrame, opts: &RetargetOptions) -> Vec3 {
+    let scale = if skeleton.leg_length > 1e-9 {
+        rig_leg_length(rig) as f64 / skeleton.leg_length
+    } else {
+        1.0
+    };
+    let p = frame.root_position;
+    let y = scale * (p.y - skeleton.rest_root_height);
+    let t = if opts.keep_horizontal_translation {
+        DVec3::new(scale * p.x, y, scale * p.z)
+    } else {
+        DVec3::new(0.0, y, 0.0)
+    };
+    t.as_vec3()
+}
+
+/// Retargets one source frame onto `rig`.
+pub fn retarget(rig: &Rig, skeleton: &SourceSkeleton, frame: &SourceFrame, opts: &RetargetOptions) -> Result<Pose, PoseError> {
+    let deltas = retarget_rotations(rig, skeleton, frame)?;
+    let t = retarget_translation(rig, skeleton, frame, opts);
+    Ok(Pose::from_world_rotations(rig, &deltas, t))
+}
+
+/// The motion data of a [`Clip`].
+#[derive(Clone, Debug, PartialEq)]
+pub enum ClipData {
+    /// An ASF skeleton and an AMC motion recorded on it.
+    AsfAmc {
+        /// The skeleton.
+        asf: Box<Asf>,
+        /// The motion.
+        amc: Box<Amc>,
+    },
+    /// A BVH file.
+    Bvh(Box<Bvh>),
+}
+
+/// A motion clip that can pose a rig frame by frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Clip {
+    /// The motion data.
+    pub data: ClipData,
+    /// The source skeleton as the retargeter sees it.
+    pub skeleton: SourceSkeleton,
+    /// Frames per second (AMC files do not say; CMU clips are 120).
+    pub frame_rate: f64,
+}
+
+impl Clip {
+    /// A clip from an ASF skeleton and an AMC motion file, at 120 frames per second.
+    pub fn from_asf_amc(asf_path: impl AsRef<Path>, amc_path: impl AsRef<Path>) -> Result<Clip, PoseError> {
+        let asf = Asf::read(asf_path)?;
+        let amc = Amc::read(amc_path, &asf)?;
+        Ok(Clip {
+            skeleton: SourceSkeleton::from_asf(&asf),
+            data: ClipData::AsfAmc {
+                asf: Box::new(asf),
+                amc: Box::new(amc),
+            },
+            frame_rate: 120.0,
+        })
+    }
+
+    /// A clip from a BVH file; `metres_per_unit` as in [`Bvh::read`].
+    pub fn from_bvh(path: impl AsRef<Path>, metres_per_unit: Option<f64>) -> Result<Clip, PoseError> {
+        let bvh = Bvh::read(path, metres_per_unit)?;
+        Ok(Clip {
+            skeleton: SourceSkeleton::from_bvh(&bvh),
+            frame_rate: bvh.frame_rate(),
+            data: ClipData::Bvh(Box::new(bvh)),
+        })
+    }
+
+    /// Number of frames.
+    pub fn frame_count(&self) -> usize {
+        match &self.data {
+            ClipData::AsfAmc { amc, .. } => amc.frame_count(),
+            ClipData::Bvh(b) => b.frame_count(),
+        }
+    }
+
+    /// Frames per second.
+    pub fn frame_rate(&self) -> f64 {
+        self.frame_rate
+    }
+
+    /// Frame `frame` (0-based) as world rotations of the source skeleton.
+    pub fn source_frame(&self, frame: usize) -> Result<SourceFrame, PoseError> {
+        match &self.data {
+            ClipData::AsfAmc { asf, amc } => Ok(SourceFrame::from_asf(asf, &asf.pose_of(amc, frame)?)),
+            ClipData::Bvh(b) => {
+                let (world, pos) = b.pose(Some(frame))?;
+                Ok(SourceFrame {
+                    world,
+                    root_position: pos.first().copied().unwrap_or(DVec3::ZERO),
+                })
+            }
+        }
+    }
+
+    /// Frame `frame` (0-based) retargeted onto `rig`.
+    pub fn pose(&self, frame: usize, rig: &Rig, opts: &RetargetOptions) -> Result<Pose, PoseError> {
+        retarget(rig, &self.skeleton, &self.source_frame(frame)?, opts)
+    }
+}

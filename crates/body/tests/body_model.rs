@@ -1,0 +1,120 @@
+//! The body model on the real assets (fetched on first use).
+
+use body::shape_sampler::{stature_and_bmi, ShapeDistribution};
+use body::{BodyModel, Phenotype, Pose, Skinning};
+use glam::{Quat, Vec3};
+use std::sync::OnceLock;
+
+fn model() -> &'static BodyModel {
+    static MODEL: OnceLock<BodyModel> = OnceLock::new();
+    MODEL.get_or_init(|| BodyModel::load().expect("body assets"))
+}
+
+#[test]
+fn default_phenotype_is_1626_mm_tall_closed_and_manifold() {
+    let body = model().shape(&Phenotype::default()).unwrap();
+    assert!((body.height() - 1.626).abs() < 0.001, "height {}", body.height());
+    let mesh = &body.mesh;
+    assert_eq!(mesh.vertices.len(), 13380);
+    assert_eq!(mesh.faces.len(), 2 * 13378);
+    let report = geom::adjacency::check_manifold(mesh.vertices.len(), &mesh.faces).unwrap();
+    assert!(report.is_ok() && report.is_closed(), "{report:?}");
+    assert_eq!(report.euler_characteristic(), 2);
+    assert!(body.volume() > 0.03, "outward orientation gives a positive volume");
+}
+
+#[test]
+fn weights_sum_to_one_with_at_most_eight_influences() {
+    let body = model().shape(&Phenotype::default()).unwrap();
+    let w = &body.weights;
+    assert_eq!(w.len(), 13380);
+    for v in 0..w.len() {
+        let row: Vec<_> = w.row(v).collect();
+        assert!(!row.is_empty() && row.len() <= 8, "vertex {v}: {} influences", row.len());
+        let s: f32 = row.iter().map(|(_, w)| w).sum();
+        assert!((s - 1.0).abs() < 1e-5, "vertex {v}: sum {s}");
+    }
+}
+
+#[test]
+fn identity_pose_reproduces_the_rest_mesh() {
+    let body = model().shape(&Phenotype { gender: 0.0, weight: 0.8, ..Default::default() }).unwrap();
+    let pose = Pose::identity(body.rig.len());
+    for method in [Skinning::Lbs, Skinning::Dqs] {
+        let posed = body.posed(&pose, method).unwrap();
+        let err = posed.vertices.iter().zip(&body.mesh.vertices).map(|(a, b)| (*a - *b).length()).fold(0.0, f32::max);
+        assert!(err < 1e-6, "{method:?}: {err}");
+    }
+}
+
+#[test]
+fn lbs_and_dqs_agree_away_from_joints_for_one_bone_rotation() {
+    let body = model().shape(&Phenotype::default()).unwrap();
+    let elbow = body.rig.index("LeftForeArm").unwrap();
+    let mut pose = Pose::identity(body.rig.len());
+    pose.rotations[elbow] = Quat::from_rotation_x(1.2);
+    let lbs = body.posed(&pose, Skinning::Lbs).unwrap();
+    let dqs = body.posed(&pose, Skinning::Dqs).unwrap();
+    // Vertices bound rigidly to one bone move identically under both methods...
+    let mut rigid = 0;
+    for v in 0..lbs.vertices.len() {
+        let row: Vec<_> = body.weights.row(v).collect();
+        if row.len() == 1 {
+            rigid += 1;
+            assert!((lbs.vertices[v] - dqs.vertices[v]).length() < 1e-5, "vertex {v}");
+        }
+    }
+    assert!(rigid > 1000);
+    // ... and the forearm really moved while the other side stayed.
+    let hand = body.rig.index("LeftHand").unwrap();
+    let joints = body.rig.posed_joints(&pose);
+    assert!((joints[hand].0 - body.rig.bones[hand].head).length() > 0.1);
+    let right = body.rig.index("RightHand").unwrap();
+    assert!((joints[right].0 - body.rig.bones[right].head).length() < 1e-6);
+}
+
+#[test]
+fn tpose_puts_the_arms_horizontal() {
+    let body = model().shape(&Phenotype::default()).unwrap();
+    let joints = body.rig.posed_joints(&model().tpose());
+    for name in ["LeftArm", "LeftForeArm", "RightArm", "RightForeArm"] {
+        let (h, t) = joints[body.rig.index(name).unwrap()];
+        let d = (t - h).normalize();
+        assert!(d.x.abs() > 0.99, "{name} direction {d}");
+    }
+    let l = joints[body.rig.index("LeftForeArm").unwrap()].1;
+    assert!(l.x > 0.5, "left hand at +X, found {l}");
+}
+
+#[test]
+fn posing_rejects_a_wrong_bone_count_and_nan() {
+    let body = model().shape(&Phenotype::default()).unwrap();
+    assert!(body.posed(&Pose::identity(3), Skinning::Dqs).is_err());
+    let mut pose = Pose::identity(body.rig.len());
+    pose.root_translation = Vec3::new(f32::NAN, 0.0, 0.0);
+    let err = body.posed(&pose, Skinning::Dqs).unwrap_err().to_string();
+    assert!(err.contains("NaN"), "{err}");
+    assert!(model().shape(&Phenotype { age: f32::NAN, ..Default::default() }).is_err());
+}
+
+#[test]
+fn random_shapes_are_realistic_adults_and_reproducible() {
+    let dist = ShapeDistribution::default();
+    let mut statures = Vec::new();
+    for seed in 0..12 {
+        let s = dist.sample(model(), seed).unwrap();
+        assert!((1.45..=2.0).contains(&s.stature), "seed {seed}: stature {}", s.stature);
+        assert!((16.0..=40.0).contains(&s.bmi), "seed {seed}: BMI {}", s.bmi);
+        assert!((s.stature - s.target_stature).abs() < 0.01, "seed {seed}: {s:?}");
+        // BMI is met, or the model's heaviest shape fell short of a high target.
+        let saturated = s.phenotype.weight >= 1.0 && s.bmi < s.target_bmi;
+        assert!((s.bmi - s.target_bmi).abs() < 0.5 || saturated, "seed {seed}: {s:?}");
+        let body = model().shape(&s.phenotype).unwrap();
+        let (h, b) = stature_and_bmi(&body);
+        assert!((h - s.stature).abs() < 1e-6 && (b - s.bmi).abs() < 1e-4);
+        statures.push(s.stature);
+    }
+    assert_eq!(dist.sample(model(), 3).unwrap(), dist.sample(model(), 3).unwrap());
+    let spread = statures.iter().cloned().fold(0.0, f32::max) - statures.iter().cloned().fold(9.0, f32::min);
+    assert!(spread > 0.08, "shapes vary: spread {spread}");
+}

@@ -1,0 +1,52 @@
+//! `garnet`: fast, accurate 3D cloth draping. Thin commands over the pipeline crates.
+
+mod assets_cmd;
+mod bench_cmd;
+mod body_cmd;
+mod output;
+mod pose_args;
+mod pose_cmd;
+mod shape_args;
+
+use clap::{Parser, Subcommand};
+
+/// garnet: fast, accurate 3D cloth draping (GarNet, ICCV 2019) in one binary.
+///
+/// With no command, runs the main job on the embedded defaults: a random realistic adult
+/// in a procedural pose, written to out/body.glb and out/body.png.
+#[derive(Parser, Debug)]
+#[command(name = "garnet", version, about, long_about)]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Option<Cmd>,
+}
+
+#[derive(Subcommand, Debug)]
+enum Cmd {
+    /// Fetch, verify and convert the body assets, or show where they are.
+    #[command(subcommand)]
+    Assets(assets_cmd::AssetsCmd),
+    /// Make a body of a given shape and pose: mesh file, picture, or a picture sheet.
+    Body(body_cmd::BodyArgs),
+    /// Pose files: convert CMU ASF/AMC clips to BVH.
+    #[command(subcommand)]
+    Pose(pose_cmd::PoseCmd),
+    /// Benchmarks measured in one run, reported with ratios to a reference.
+    #[command(subcommand)]
+    Bench(bench_cmd::BenchCmd),
+}
+
+fn main() {
+    let cli = Cli::parse();
+    let result = match &cli.cmd {
+        None => body_cmd::run(&body_cmd::BodyArgs::main_job()),
+        Some(Cmd::Assets(c)) => assets_cmd::run(c),
+        Some(Cmd::Body(a)) => body_cmd::run(a),
+        Some(Cmd::Pose(c)) => pose_cmd::run(c),
+        Some(Cmd::Bench(c)) => bench_cmd::run(c),
+    };
+    if let Err(e) = result {
+        eprintln!("garnet: error: {e:#}");
+        std::process::exit(1);
+    }
+}

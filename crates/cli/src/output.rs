@@ -1,0 +1,39 @@
+//! Writing meshes and pictures for the commands.
+
+use std::path::Path;
+
+use anyhow::Context;
+use geom::TriMesh;
+use render::{RenderMesh, View};
+
+/// Writes `mesh` to `path` in the format its extension names (.obj, .ply, .glb).
+pub fn write_mesh(path: &Path, mesh: &TriMesh) -> anyhow::Result<()> {
+    create_parent(path)?;
+    geom::io::write_mesh(path, mesh).with_context(|| format!("writing {}", path.display()))?;
+    eprintln!("wrote {}", path.display());
+    Ok(())
+}
+
+/// Renders the front and side views of `meshes` (`(mesh, colour)`) at `size` pixels
+/// per view and saves a PNG.
+pub fn write_png(path: &Path, meshes: &[(&TriMesh, [u8; 3])], size: (u32, u32)) -> anyhow::Result<()> {
+    create_parent(path)?;
+    let image = render_views(meshes, size)?;
+    image.save_png(path).with_context(|| format!("writing {}", path.display()))?;
+    eprintln!("wrote {}", path.display());
+    Ok(())
+}
+
+/// Front and side views of `meshes` side by side.
+pub fn render_views(meshes: &[(&TriMesh, [u8; 3])], size: (u32, u32)) -> anyhow::Result<render::Image> {
+    let scene: Vec<RenderMesh> = meshes.iter().map(|(m, c)| RenderMesh::new(&m.vertices, &m.faces, *c)).collect();
+    Ok(render::render_views(&scene, &[View::Front, View::Side], size)?)
+}
+
+/// Creates the parent directory of `path` if it is missing.
+pub fn create_parent(path: &Path) -> anyhow::Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    Ok(())
+}

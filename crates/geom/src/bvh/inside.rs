@@ -1,0 +1,182 @@
+//! Inside/outside tests and signed distance for closed, consistently oriented meshes.
+//!
+//! A point's winding number is counted along a ray as (exits - entries), each crossing
+//! signed by the face normal; three rays in fixed generic directions vote, so a ray grazing
+//! an edge or vertex (counted twice or not at all) is outvoted. Unlike crossing parity, this
+//! stays right where a posed body overlaps itself (winding number 2 there).
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::{Bvh, Node};
+use crate::tri::ray_triangle;
+
+/// Ray directions: unit vectors far from the axes and from each other, so grid-aligned
+/// meshes do not put edges in their path.
+const DIRS: [Vec3; 3] = [
+    Vec3::new(0.540_606_7, 0.657_192_3, 0.525_296_4),
+    Vec3::new(-0.613_196_2, 0.371_390_7, -0.697_191_5),
+    Vec3::new(0.392_232_1, -0.803_030_7, -0.448_679_8),
+];
+
+/// Whether the ray `o + t d`, `t in [0, t_max]`, meets the box of `n`.
+#[inline]
+pub(super) fn ray_box(n: &Node, o: Vec3, d: Vec3, inv: Vec3, t_max: f32) -> bool {
+    let (mut t0, mut t1) = (0.0f32, t_max);
+    for k in 0..3 {
+        if d[k] == 0.0 {
+            if o[k] < n.min[k] || o[k] > n.max[k] {
+                return false;
+            }
+            continue;
+        }
+        let a = (n.min[k] - o[k]) * inv[k];
+        let b = (n.max[k] - o[k]) * inv[k];
+        t0 = t0.max(a.min(b));
+        t1 = t1.min(a.max(b));
+        if t0 > t1 {
+            return false;
+        }
+    }
+    true
+}
+
+impl Bvh {
+    /// Winding number of `p` counted along the ray from `p` in direction `dir`:
+    /// exits minus entries (a crossing is an exit when the face normal points along the ray).
+    pub fn ray_winding(&self, p: Vec3, dir: Vec3) -> i32 {
+        if self.nodes.is_empty() {
+            return 0;
+        }
+        let inv = dir.recip();
+        let mut w = 0;
+        let mut stack: Vec<u32> = Vec::with_capacity(64);
+        stack.push(0);
+        while let Some(ni) = stack.pop() {
+            let n = &self.nodes[ni as usize];
+            if !ray_box(n, p, dir, inv, f32::INFINITY) {
+                continue;
+            }
+            if n.is_leaf() {
+                for &fi in self.leaf_faces(n) {
+                    let [a, b, c] = self.tri(fi);
+                    if let Some((t, _)) = ray_triangle(p, dir, f32::INFINITY, a, b, c) {
+                        if t > 0.0 {
+                            let s = (b - a).cross(c - a).dot(dir);
+                            w += if s > 0.0 { 1 } else { -1 };
+                        }
+                    }
+                }
+            } else {
+                stack.push(n.start);
+                stack.push(n.start + 1);
+            }
+        }
+        w
+    }
+
+    /// Whether `p` is inside the mesh (winding number at least 1 along a majority of three
+    /// rays). Meaningful for closed, outward-oriented meshes; `false` for an empty mesh or a
+    /// non-finite `p`. Points within about a micrometre of the surface may go either way.
+    pub fn contains(&self, p: Vec3) -> bool {
+        if !p.is_finite() {
+            return false;
+        }
+        DIRS.iter().filter(|&&d| self.ray_winding(p, d) > 0).count() >= 2
+    }
+
+    /// Signed distance from `p` to the mesh (metres): negative inside (see [`Bvh::contains`]),
+    /// positive outside; `None` for an empty mesh or a non-finite `p`.
+    pub fn signed_distance(&self, p: Vec3) -> Option<f32> {
+        let d = self.closest_point(p)?.distance;
+        Some(if self.contains(p) { -d } else { d })
+    }
+
+    /// [`Bvh::contains`] for every point of `points` (`[Q]`), in parallel; `[Q]` results.
+    pub fn contains_points(&self, points: &[Vec3]) -> Vec<bool> {
+        points.par_iter().map(|&p| self.contains(p)).collect()
+    }
+
+    /// [`Bvh::signed_distance`] for every point of `points` (`[Q]`), in parallel; `[Q]`
+    /// results, NaN where the distance is undefined (empty mesh, non-finite point).
+    pub fn signed_distances(&self, points: &[Vec3]) -> Vec<f32> {
+        points.par_iter().map(|&p| self.signed_distance(p).unwrap_or(f32::NAN)).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::{noisy_sphere, Rng};
+    use super::*;
+    use crate::tri::winding_number;
+    use crate::TriMesh;
+
+    #[test]
+    fn directions_are_unit() {
+        for d in DIRS {
+            assert!((d.length() - 1.0).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn sphere_inside_matches_analytic() {
+        let r = 0.8;
+        let m = TriMesh::icosphere(3, r);
+        let bvh = Bvh::from_mesh(&m).unwrap();
+        // The icosphere lies between the inscribed radius and r.
+        let inner = r * 0.99;
+        let mut rng = Rng(2);
+        let pts: Vec<Vec3> = (0..2000).map(|_| rng.vec3(1.2)).collect();
+        let inside = bvh.contains_points(&pts);
+        let sd = bvh.signed_distances(&pts);
+        for ((p, ins), d) in pts.iter().zip(inside).zip(sd) {
+            let l = p.length();
+            if l < inner {
+                assert!(ins, "{p} should be inside");
+                assert!(d < 0.0 && (d + (r - l)).abs() < 0.01);
+            } else if l > r * 1.001 {
+                assert!(!ins, "{p} should be outside");
+                assert!(d > 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn noisy_mesh_matches_winding_number_and_grid_points() {
+        let m = noisy_sphere(3, 9);
+        let bvh = Bvh::from_mesh(&m).unwrap();
+        let mut pts: Vec<Vec3> = Vec::new();
+        // Grid-aligned points (x = 0 plane and axis lines hit vertices of the icosphere).
+        for i in -6..=6 {
+            for j in -6..=6 {
+                pts.push(Vec3::new(0.0, i as f32 * 0.2, j as f32 * 0.2));
+            }
+        }
+        let mut rng = Rng(4);
+        pts.extend((0..500).map(|_| rng.vec3(1.3)));
+        for p in pts {
+            let w = winding_number(&m.vertices, &m.faces, p);
+            if (w - 0.5).abs() < 0.45 {
+                continue; // on the surface
+            }
+            assert_eq!(bvh.contains(p), w > 0.5, "{p}: winding {w}");
+        }
+    }
+
+    #[test]
+    fn overlapping_shells_count_as_inside() {
+        let mut m = TriMesh::icosphere(2, 1.0);
+        let mut other = TriMesh::icosphere(2, 1.0);
+        for v in &mut other.vertices {
+            v.x += 0.5;
+        }
+        m.append(&other).unwrap();
+        let bvh = Bvh::from_mesh(&m).unwrap();
+        assert!(bvh.contains(Vec3::new(0.25, 0.0, 0.0))); // inside both: winding 2
+        assert!(bvh.contains(Vec3::new(-0.7, 0.0, 0.0)));
+        assert!(!bvh.contains(Vec3::new(2.0, 0.0, 0.0)));
+        let cube = Bvh::from_mesh(&TriMesh::cuboid(Vec3::ONE)).unwrap();
+        assert!(cube.contains(Vec3::ZERO) && !cube.contains(Vec3::splat(1.5)));
+        assert!(cube.contains(Vec3::new(0.999, 0.0, 0.0)));
+    }
+}
