@@ -101,3 +101,22 @@ impl SelfContact {
             .count()
     }
 }
+
+/// Draws procedural poses from `generator` until one poses `body` (with DQS) without
+/// self-intersection; errors after `max_tries` rejected draws.
+pub fn sample_valid_pose(
+    body: &ShapedBody,
+    generator: &mut crate::pose::ProceduralPoseGenerator,
+    max_tries: usize,
+) -> Result<crate::rig::Pose, crate::BodyError> {
+    let contact = SelfContact::new(body);
+    let pose = generator.sample_accepted(
+        &body.rig,
+        |pose| {
+            body.posed(pose, crate::skin::Skinning::Dqs)
+                .is_ok_and(|mesh| contact.count_intersections(&mesh) == 0)
+        },
+        max_tries,
+    )?;
+    Ok(pose)
+}

@@ -35,6 +35,20 @@ pub struct ShapeArgs {
 }
 
 impl ShapeArgs {
+    /// The flag defaults (the default phenotype), as clap would fill them.
+    pub fn defaults() -> Self {
+        Self {
+            random_shape: None,
+            gender: 0.5,
+            age: 0.5,
+            muscle: 0.5,
+            weight: 0.5,
+            height: 0.5,
+            proportions: 0.5,
+            race: vec![1.0, 1.0, 1.0],
+        }
+    }
+
     /// The phenotype these arguments describe (solving a random shape if asked).
     pub fn phenotype(&self, model: &BodyModel) -> anyhow::Result<Phenotype> {
         if let Some(seed) = self.random_shape {

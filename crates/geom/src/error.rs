@@ -64,22 +64,36 @@ pub enum GeomError {
 impl GeomError {
     /// An I/O error on `path`.
     pub fn io(path: &Path, source: std::io::Error) -> Self {
-        GeomError::Io { path: path.to_path_buf(), source }
+        GeomError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
     }
 
     /// A parse error at 1-based `line` of the text file `path`.
     pub fn text(path: &Path, line: usize, msg: impl Into<String>) -> Self {
-        GeomError::Text { path: path.to_path_buf(), line, msg: msg.into() }
+        GeomError::Text {
+            path: path.to_path_buf(),
+            line,
+            msg: msg.into(),
+        }
     }
 
     /// A parse error at byte `offset` of the binary file `path`.
     pub fn binary(path: &Path, offset: u64, msg: impl Into<String>) -> Self {
-        GeomError::Binary { path: path.to_path_buf(), offset, msg: msg.into() }
+        GeomError::Binary {
+            path: path.to_path_buf(),
+            offset,
+            msg: msg.into(),
+        }
     }
 
     /// A content error in the file `path`.
     pub fn format(path: &Path, msg: impl Into<String>) -> Self {
-        GeomError::Format { path: path.to_path_buf(), msg: msg.into() }
+        GeomError::Format {
+            path: path.to_path_buf(),
+            msg: msg.into(),
+        }
     }
 }
 
@@ -90,11 +104,17 @@ mod tests {
     #[test]
     fn messages_name_path_and_position() {
         let p = Path::new("dir/a.obj");
-        assert_eq!(GeomError::text(p, 7, "bad token").to_string(), "dir/a.obj:7: bad token");
+        assert_eq!(
+            GeomError::text(p, 7, "bad token").to_string(),
+            "dir/a.obj:7: bad token"
+        );
         assert_eq!(
             GeomError::binary(Path::new("b.ply"), 120, "truncated").to_string(),
             "b.ply: byte 120: truncated"
         );
-        assert_eq!(GeomError::format(p, "no mesh").to_string(), "dir/a.obj: no mesh");
+        assert_eq!(
+            GeomError::format(p, "no mesh").to_string(),
+            "dir/a.obj: no mesh"
+        );
     }
 }

@@ -32,12 +32,16 @@ impl KnnResult {
 
     /// Neighbour indices of query `q` (`[K]`); empty if `q` is out of range.
     pub fn row(&self, q: usize) -> &[u32] {
-        self.indices.get(q * self.k..(q + 1) * self.k).unwrap_or(&[])
+        self.indices
+            .get(q * self.k..(q + 1) * self.k)
+            .unwrap_or(&[])
     }
 
     /// Squared distances of query `q` (`[K]`); empty if `q` is out of range.
     pub fn sq_row(&self, q: usize) -> &[f32] {
-        self.sq_distances.get(q * self.k..(q + 1) * self.k).unwrap_or(&[])
+        self.sq_distances
+            .get(q * self.k..(q + 1) * self.k)
+            .unwrap_or(&[])
     }
 }
 
@@ -55,15 +59,21 @@ impl std::fmt::Debug for KnnIndex {
 
 fn check_points(what: &str, pts: &[Vec3]) -> Result<()> {
     if let Some(i) = pts.iter().position(|p| !p.is_finite()) {
-        return Err(GeomError::InvalidInput(format!("{what} {i} is not finite: {}", pts[i])));
+        return Err(GeomError::InvalidInput(format!(
+            "{what} {i} is not finite: {}",
+            pts[i]
+        )));
     }
     Ok(())
 }
 
 fn check_k(k: usize, n: usize) -> Result<NonZeroUsize> {
-    let nz = NonZeroUsize::new(k).ok_or_else(|| GeomError::InvalidInput("k must be at least 1".into()))?;
+    let nz = NonZeroUsize::new(k)
+        .ok_or_else(|| GeomError::InvalidInput("k must be at least 1".into()))?;
     if k > n {
-        return Err(GeomError::InvalidInput(format!("k = {k} exceeds the {n} points")));
+        return Err(GeomError::InvalidInput(format!(
+            "k = {k} exceeds the {n} points"
+        )));
     }
     Ok(nz)
 }
@@ -74,10 +84,15 @@ impl KnnIndex {
     pub fn new(points: &[Vec3]) -> Result<KnnIndex> {
         check_points("point", points)?;
         if points.len() > u32::MAX as usize {
-            return Err(GeomError::InvalidInput("too many points for u32 indices".into()));
+            return Err(GeomError::InvalidInput(
+                "too many points for u32 indices".into(),
+            ));
         }
         let arr: Vec<[f32; 3]> = points.iter().map(|p| p.to_array()).collect();
-        Ok(KnnIndex { tree: ImmutableKdTree::new_from_slice(&arr), len: points.len() })
+        Ok(KnnIndex {
+            tree: ImmutableKdTree::new_from_slice(&arr),
+            len: points.len(),
+        })
     }
 
     /// Number of indexed points P.
@@ -110,7 +125,11 @@ impl KnnIndex {
                     dr[j] = nb.distance;
                 }
             });
-        Ok(KnnResult { k, indices, sq_distances: sq })
+        Ok(KnnResult {
+            k,
+            indices,
+            sq_distances: sq,
+        })
     }
 
     /// The nearest indexed point to `q`: `(index, squared distance)`; `None` for an empty
@@ -141,14 +160,23 @@ pub fn knn_brute(points: &[Vec3], queries: &[Vec3], k: usize) -> Result<KnnResul
     let mut all: Vec<(f32, u32)> = Vec::with_capacity(points.len());
     for q in queries {
         all.clear();
-        all.extend(points.iter().enumerate().map(|(i, p)| (p.distance_squared(*q), i as u32)));
+        all.extend(
+            points
+                .iter()
+                .enumerate()
+                .map(|(i, p)| (p.distance_squared(*q), i as u32)),
+        );
         all.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         for &(d, i) in &all[..k] {
             indices.push(i);
             sq.push(d);
         }
     }
-    Ok(KnnResult { k, indices, sq_distances: sq })
+    Ok(KnnResult {
+        k,
+        indices,
+        sq_distances: sq,
+    })
 }
 
 #[cfg(test)]
@@ -165,11 +193,13 @@ mod tests {
             let a = knn(&pts, &qs, k).unwrap();
             let b = knn_brute(&pts, &qs, k).unwrap();
             assert_eq!(a.num_queries(), 300);
-            for q in 0..qs.len() {
+            for (q, qp) in qs.iter().enumerate() {
                 for j in 0..k {
-                    assert!((a.sq_row(q)[j] - b.sq_row(q)[j]).abs() <= 1e-6 * (1.0 + b.sq_row(q)[j]));
+                    assert!(
+                        (a.sq_row(q)[j] - b.sq_row(q)[j]).abs() <= 1e-6 * (1.0 + b.sq_row(q)[j])
+                    );
                     let i = a.row(q)[j] as usize;
-                    assert!((pts[i].distance_squared(qs[q]) - a.sq_row(q)[j]).abs() < 1e-6);
+                    assert!((pts[i].distance_squared(*qp) - a.sq_row(q)[j]).abs() < 1e-6);
                 }
             }
             // Random continuous data has no ties: indices agree too.
@@ -187,7 +217,9 @@ mod tests {
             }
         }
         let idx = KnnIndex::new(&pts).unwrap();
-        let r = idx.query(&[Vec3::splat(0.5), Vec3::new(0.101, 0.0, 0.2)], 10).unwrap();
+        let r = idx
+            .query(&[Vec3::splat(0.5), Vec3::new(0.101, 0.0, 0.2)], 10)
+            .unwrap();
         assert!(r.sq_row(0).iter().all(|&d| d == 0.0));
         assert!(r.row(0).iter().all(|&i| i < 500));
         let b = knn_brute(&pts, &[Vec3::new(0.101, 0.0, 0.2)], 10).unwrap();

@@ -5,6 +5,8 @@
 //! `[F]` of `[u32; 3]`, counter-clockwise seen from outside. No function panics on bad input:
 //! fallible ones return [`GeomError`]; the per-step numeric kernels ([`normals`]) are total.
 
+#![warn(missing_docs)]
+
 pub mod adjacency;
 pub mod bvh;
 pub mod error;

@@ -11,7 +11,9 @@ use crate::error::{GeomError, Result};
 ///   (outward normals for a closed surface).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TriMesh {
+    /// `[N]` vertex positions, metres.
     pub vertices: Vec<Vec3>,
+    /// `[F]` triangles, indices into `vertices`, counter-clockwise seen from outside.
     pub faces: Vec<[u32; 3]>,
 }
 
@@ -73,14 +75,22 @@ impl TriMesh {
                 "{n} vertices do not fit u32 indices"
             )));
         }
-        if let Some((i, v)) = self.vertices.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        if let Some((i, v)) = self
+            .vertices
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !v.is_finite())
+        {
             return Err(GeomError::InvalidMesh(format!(
                 "vertex {i} has a non-finite coordinate ({}, {}, {})",
                 v.x, v.y, v.z
             )));
         }
-        if let Some((fi, f)) =
-            self.faces.iter().enumerate().find(|(_, f)| f.iter().any(|&i| i as usize >= n))
+        if let Some((fi, f)) = self
+            .faces
+            .iter()
+            .enumerate()
+            .find(|(_, f)| f.iter().any(|&i| i as usize >= n))
         {
             return Err(GeomError::InvalidMesh(format!(
                 "face {fi} = {f:?} has a vertex index out of range (mesh has {n} vertices)"
@@ -92,7 +102,11 @@ impl TriMesh {
     /// Axis-aligned bounds `(min, max)` of the vertices (metres); `None` when there are none.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         let first = *self.vertices.first()?;
-        Some(self.vertices.iter().fold((first, first), |(lo, hi), &v| (lo.min(v), hi.max(v))))
+        Some(
+            self.vertices
+                .iter()
+                .fold((first, first), |(lo, hi), &v| (lo.min(v), hi.max(v))),
+        )
     }
 
     /// Unit face normals `[F]` (zero for degenerate faces); see [`crate::normals::face_normals`].
@@ -145,9 +159,13 @@ impl TriMesh {
         }
         let off = offset as u32;
         self.vertices.extend_from_slice(&other.vertices);
-        self.faces.extend(
-            other.faces.iter().map(|f| [f[0].wrapping_add(off), f[1].wrapping_add(off), f[2].wrapping_add(off)]),
-        );
+        self.faces.extend(other.faces.iter().map(|f| {
+            [
+                f[0].wrapping_add(off),
+                f[1].wrapping_add(off),
+                f[2].wrapping_add(off),
+            ]
+        }));
         Ok(())
     }
 

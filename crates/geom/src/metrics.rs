@@ -78,7 +78,10 @@ pub fn face_normal_angles(gt: &[Vec3], pred: &[Vec3], faces: &[[u32; 3]]) -> Res
             ((b - a) / s).cross((c - a) / s)
         }
     };
-    Ok(faces.iter().map(|f| angle_between(cross(gt, f), cross(pred, f))).collect())
+    Ok(faces
+        .iter()
+        .map(|f| angle_between(cross(gt, f), cross(pred, f)))
+        .collect())
 }
 
 /// `E_norm`: mean face-normal angle (radians); 0 for no faces.
@@ -128,7 +131,9 @@ pub fn linspace(max: f32, count: usize) -> Vec<f32> {
     match count {
         0 => Vec::new(),
         1 => vec![max],
-        _ => (0..count).map(|i| max * i as f32 / (count - 1) as f32).collect(),
+        _ => (0..count)
+            .map(|i| max * i as f32 / (count - 1) as f32)
+            .collect(),
     }
 }
 
@@ -158,7 +163,11 @@ mod tests {
         let e = rad_to_deg(e_norm(&m.vertices, &pred, &m.faces).unwrap());
         assert!((e - 30.0).abs() < 1e-3, "{e}");
         // Flipped faces: 180 degrees. Tiny faces still measure correctly.
-        let flipped: Vec<Vec3> = m.vertices.iter().map(|&v| Vec3::new(v.x, 0.0, -v.z)).collect();
+        let flipped: Vec<Vec3> = m
+            .vertices
+            .iter()
+            .map(|&v| Vec3::new(v.x, 0.0, -v.z))
+            .collect();
         let a = face_normal_angles(&m.vertices, &flipped, &m.faces).unwrap();
         assert!(a.iter().all(|&x| (x - std::f32::consts::PI).abs() < 1e-5));
         let tiny: Vec<Vec3> = m.vertices.iter().map(|&v| v * 1e-20).collect();
@@ -175,7 +184,10 @@ mod tests {
     #[test]
     fn precision_curves() {
         let v = [0.5, 1.0, 2.0, f32::NAN];
-        assert_eq!(precision_curve(&v, &[0.0, 0.5, 1.5, 10.0]), vec![0.0, 0.25, 0.5, 0.75]);
+        assert_eq!(
+            precision_curve(&v, &[0.0, 0.5, 1.5, 10.0]),
+            vec![0.0, 0.25, 0.5, 0.75]
+        );
         assert_eq!(precision_curve(&[], &[1.0]), vec![0.0]);
         assert_eq!(linspace(2.0, 3), vec![0.0, 1.0, 2.0]);
         assert!(linspace(1.0, 0).is_empty());

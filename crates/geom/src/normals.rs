@@ -30,7 +30,10 @@ fn cross(vertices: &[Vec3], f: &[u32; 3]) -> Vec3 {
 ///
 /// - `vertices`: `[N]` positions; `faces`: `[F]` triangles.
 pub fn face_normals(vertices: &[Vec3], faces: &[[u32; 3]]) -> Vec<Vec3> {
-    faces.iter().map(|f| cross(vertices, f).normalize_or_zero()).collect()
+    faces
+        .iter()
+        .map(|f| cross(vertices, f).normalize_or_zero())
+        .collect()
 }
 
 /// Area-weighted face normals `[F]`: direction of the face normal, length = face area (m^2).
@@ -40,7 +43,10 @@ pub fn face_area_normals(vertices: &[Vec3], faces: &[[u32; 3]]) -> Vec<Vec3> {
 
 /// Face areas `[F]` in square metres.
 pub fn face_areas(vertices: &[Vec3], faces: &[[u32; 3]]) -> Vec<f32> {
-    faces.iter().map(|f| 0.5 * cross(vertices, f).length()).collect()
+    faces
+        .iter()
+        .map(|f| 0.5 * cross(vertices, f).length())
+        .collect()
 }
 
 /// Area-weighted unit vertex normals `[N]` (`N = vertices.len()`): each vertex gets the
@@ -82,7 +88,10 @@ mod tests {
             assert!((n.length() - 1.0).abs() < 1e-5);
             assert!(n.dot(v.normalize()) > 0.99);
         }
-        let a: f32 = face_area_normals(&m.vertices, &m.faces).iter().map(|n| n.length()).sum();
+        let a: f32 = face_area_normals(&m.vertices, &m.faces)
+            .iter()
+            .map(|n| n.length())
+            .sum();
         assert!((a - m.surface_area()).abs() < 1e-4);
     }
 
@@ -100,7 +109,13 @@ mod tests {
     #[test]
     fn area_weighting() {
         // A big face and a small face sharing vertex 0, at right angles.
-        let v = vec![Vec3::ZERO, 10.0 * Vec3::X, 10.0 * Vec3::Y, Vec3::Z, 0.1 * Vec3::X];
+        let v = vec![
+            Vec3::ZERO,
+            10.0 * Vec3::X,
+            10.0 * Vec3::Y,
+            Vec3::Z,
+            0.1 * Vec3::X,
+        ];
         let faces = vec![[0, 1, 2], [0, 3, 4]];
         let n = vertex_normals(&v, &faces)[0];
         assert!(n.z > 0.99 && n.y > 0.0);

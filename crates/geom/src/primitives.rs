@@ -94,7 +94,11 @@ impl TriMesh {
         let mut vertices = Vec::with_capacity(nx * nz);
         for j in 0..nz {
             for i in 0..nx {
-                vertices.push(Vec3::new((i as f32 - cx) * spacing, 0.0, (j as f32 - cz) * spacing));
+                vertices.push(Vec3::new(
+                    (i as f32 - cx) * spacing,
+                    0.0,
+                    (j as f32 - cz) * spacing,
+                ));
             }
         }
         let mut faces = Vec::with_capacity(2 * (nx - 1) * (nz - 1));
@@ -166,7 +170,10 @@ mod tests {
         assert_eq!(g.vertices.len(), 12);
         assert_eq!(g.faces.len(), 12);
         assert_eq!(g.vertices[0], Vec3::new(-0.5, 0.0, -0.75));
-        assert!(g.face_normals().iter().all(|n| (*n - Vec3::Y).length() < 1e-6));
+        assert!(g
+            .face_normals()
+            .iter()
+            .all(|n| (*n - Vec3::Y).length() < 1e-6));
         assert!(TriMesh::grid(1, 5, 1.0).is_empty());
     }
 

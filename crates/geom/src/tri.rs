@@ -9,7 +9,11 @@ use glam::{DVec3, Vec3};
 pub fn closest_point_on_segment(p: Vec3, a: Vec3, b: Vec3) -> (Vec3, f32) {
     let ab = b - a;
     let l2 = ab.length_squared();
-    let t = if l2 > 0.0 { ((p - a).dot(ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
+    let t = if l2 > 0.0 {
+        ((p - a).dot(ab) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     (a + t * ab, t)
 }
 
@@ -88,33 +92,48 @@ pub fn closest_point_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> (Vec3, [
 
 /// Intersection of the ray `origin + t * dir` (or of the segment `t in [0, t_max]`) with
 /// triangle `(a, b, c)` by Moeller-Trumbore: `Some((t, [wa, wb, wc]))` with `t` in
-/// `[0, t_max]`. Boundaries count as hits; triangles parallel to the ray and degenerate
-/// triangles never hit.
+/// `[0, t_max]`. Boundaries count as hits; degenerate triangles and rays parallel to the
+/// triangle's plane (within about 1e-10 rad, which includes coplanar segments) never hit.
+///
+/// Computed in f64: near-grazing crossings divide by a small determinant, and in f32 the
+/// rounding noise there produced false hits far from the triangle. The f32 inputs are exact
+/// in f64, so the answer is reliable down to the 1e-10 cut-off.
 #[inline]
-pub fn ray_triangle(origin: Vec3, dir: Vec3, t_max: f32, a: Vec3, b: Vec3, c: Vec3) -> Option<(f32, [f32; 3])> {
-    let e1 = b - a;
-    let e2 = c - a;
-    let h = dir.cross(e2);
+pub fn ray_triangle(
+    origin: Vec3,
+    dir: Vec3,
+    t_max: f32,
+    a: Vec3,
+    b: Vec3,
+    c: Vec3,
+) -> Option<(f32, [f32; 3])> {
+    let (o, d, a) = (origin.as_dvec3(), dir.as_dvec3(), a.as_dvec3());
+    let e1 = b.as_dvec3() - a;
+    let e2 = c.as_dvec3() - a;
+    let h = d.cross(e2);
     let det = e1.dot(h);
-    if det == 0.0 || !det.is_finite() {
+    // det is the triple product of e1, dir, e2; relative to their lengths it measures how far
+    // the ray is from parallel to the triangle's plane.
+    let scale = e1.length() * e2.length() * d.length();
+    if !det.is_finite() || det.abs() <= 1e-10 * scale {
         return None;
     }
     let inv = 1.0 / det;
-    let s = origin - a;
+    let s = o - a;
     let u = inv * s.dot(h);
     if !(0.0..=1.0).contains(&u) {
         return None;
     }
     let q = s.cross(e1);
-    let v = inv * dir.dot(q);
+    let v = inv * d.dot(q);
     if v < 0.0 || u + v > 1.0 {
         return None;
     }
     let t = inv * e2.dot(q);
-    if !(0.0..=t_max).contains(&t) {
+    if !(0.0..=t_max as f64).contains(&t) {
         return None;
     }
-    Some((t, [1.0 - u - v, u, v]))
+    Some((t as f32, [(1.0 - u - v) as f32, u as f32, v as f32]))
 }
 
 /// Intersection of the segment `[p, q]` with triangle `(a, b, c)`: `Some((t, bary))` with the
@@ -143,9 +162,11 @@ pub fn solid_angle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f64 {
 pub fn winding_number(vertices: &[Vec3], faces: &[[u32; 3]], p: Vec3) -> f64 {
     let mut sum = 0.0;
     for f in faces {
-        if let (Some(&a), Some(&b), Some(&c)) =
-            (vertices.get(f[0] as usize), vertices.get(f[1] as usize), vertices.get(f[2] as usize))
-        {
+        if let (Some(&a), Some(&b), Some(&c)) = (
+            vertices.get(f[0] as usize),
+            vertices.get(f[1] as usize),
+            vertices.get(f[2] as usize),
+        ) {
             sum += solid_angle(p, a, b, c);
         }
     }
@@ -196,16 +217,35 @@ mod tests {
     #[test]
     fn segment_crossings() {
         let (a, b, c) = (Vec3::ZERO, Vec3::X, Vec3::Y);
-        let (t, w) = segment_triangle(Vec3::new(0.25, 0.25, 1.0), Vec3::new(0.25, 0.25, -1.0), a, b, c).unwrap();
+        let (t, w) = segment_triangle(
+            Vec3::new(0.25, 0.25, 1.0),
+            Vec3::new(0.25, 0.25, -1.0),
+            a,
+            b,
+            c,
+        )
+        .unwrap();
         assert!((t - 0.5).abs() < 1e-6 && (w[1] - 0.25).abs() < 1e-6);
-        assert!(segment_triangle(Vec3::new(0.25, 0.25, 1.0), Vec3::new(0.25, 0.25, 0.5), a, b, c).is_none());
-        assert!(segment_triangle(Vec3::new(2.0, 2.0, 1.0), Vec3::new(2.0, 2.0, -1.0), a, b, c).is_none());
+        assert!(segment_triangle(
+            Vec3::new(0.25, 0.25, 1.0),
+            Vec3::new(0.25, 0.25, 0.5),
+            a,
+            b,
+            c
+        )
+        .is_none());
+        assert!(
+            segment_triangle(Vec3::new(2.0, 2.0, 1.0), Vec3::new(2.0, 2.0, -1.0), a, b, c)
+                .is_none()
+        );
     }
 
     #[test]
     fn winding_number_of_sphere() {
         let s = TriMesh::icosphere(2, 1.0);
-        assert!((winding_number(&s.vertices, &s.faces, Vec3::new(0.1, 0.2, 0.3)) - 1.0).abs() < 1e-6);
+        assert!(
+            (winding_number(&s.vertices, &s.faces, Vec3::new(0.1, 0.2, 0.3)) - 1.0).abs() < 1e-6
+        );
         assert!(winding_number(&s.vertices, &s.faces, Vec3::new(1.5, 0.2, 0.3)).abs() < 1e-6);
     }
 }

@@ -255,8 +255,8 @@ struct HierarchyParser<'a, 'b> {
     channels: usize,
 }
 
-impl HierarchyParser<'_, '_> {
-    fn next(&mut self, what: &str) -> Result<(usize, &str), PoseError> {
+impl<'a> HierarchyParser<'a, '_> {
+    fn next(&mut self, what: &str) -> Result<(usize, &'a str), PoseError> {
         let t = self.tokens.get(self.at).copied().ok_or_else(|| {
             PoseError::parse(self.path, self.end_line, format!("hierarchy ends where {what} was expected"))
         })?;
@@ -303,19 +303,22 @@ impl HierarchyParser<'_, '_> {
                     if !self.joints[index].channels.is_empty() {
                         return Err(PoseError::parse(self.path, ln, "second CHANNELS line in one joint"));
                     }
-                    let (ln, n) = self.next("a channel count")?;
+                    let (_, n) = self.next("a channel count")?;
                     let n: usize = n
                         .parse()
                         .ok()
                         .filter(|&n| n <= 6)
                         .ok_or_else(|| PoseError::parse(self.path, ln, format!("CHANNELS: bad channel count '{n}' (0 to 6)")))?;
-                    for _ in 0..n {
+                    for k in 0..n {
                         let (cl, c) = self.next("a channel name")?;
                         let ch = BvhChannel::parse(c).ok_or_else(|| {
                             PoseError::parse(
                                 self.path,
-                                cl,
-                                format!("CHANNELS {n}: expected a channel name such as Zrotation, found '{c}' (wrong channel count?)"),
+                                ln,
+                                format!(
+                                    "CHANNELS {n}: channel {} is '{c}' (line {cl}), not a channel name such as Zrotation (wrong channel count?)",
+                                    k + 1
+                                ),
                             )
                         })?;
                         self.joints[index].channels.push(ch);

@@ -12,9 +12,18 @@ mod bvh_write;
 pub mod cmu;
 mod error;
 pub mod euler;
+pub mod procedural;
 mod retarget;
 mod source;
 pub mod synthetic;
+#[cfg(test)]
+mod test_util;
+#[cfg(test)]
+mod tests_asf;
+#[cfg(test)]
+mod tests_bvh;
+#[cfg(test)]
+mod tests_retarget;
 
 pub use amc::Amc;
 pub use asf::{Asf, AsfBone, AsfRoot, AsfUnits, Dof};
@@ -22,6 +31,10 @@ pub use asf_fk::AsfPose;
 pub use bvh::{Bvh, BvhChannel, BvhJoint};
 pub use bvh_write::{bvh_string, save_bvh, BvhWriteOptions};
 pub use error::PoseError;
+pub use procedural::{
+    AnatomicalPose, JointAngles, JointLimits, KeyPose, PoseFamily, PoseKind,
+    ProceduralPoseGenerator, WalkParams,
+};
 pub use retarget::{
     retarget, retarget_rotations, retarget_translation, rig_leg_length, Clip, ClipData,
     RetargetOptions,

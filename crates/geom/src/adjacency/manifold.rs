@@ -118,8 +118,10 @@ pub fn check_manifold(n_vertices: usize, faces: &[[u32; 3]]) -> Result<ManifoldR
         ..Default::default()
     };
     let degenerate = |f: &[u32; 3]| f[0] == f[1] || f[1] == f[2] || f[2] == f[0];
-    r.degenerate_faces =
-        (0..faces.len()).filter(|&i| degenerate(&faces[i])).map(|i| i as u32).collect();
+    r.degenerate_faces = (0..faces.len())
+        .filter(|&i| degenerate(&faces[i]))
+        .map(|i| i as u32)
+        .collect();
 
     // Corners (3 f + k) of the same vertex are united when their faces share an edge at it.
     let mut parent: Vec<u32> = (0..faces.len() as u32 * 3).collect();
@@ -139,7 +141,11 @@ pub fn check_manifold(n_vertices: usize, faces: &[[u32; 3]]) -> Result<ManifoldR
             }
             _ => r.non_manifold_edges.push([a, b]),
         }
-        let good: Vec<u32> = fs.iter().copied().filter(|&f| !degenerate(&faces[f as usize])).collect();
+        let good: Vec<u32> = fs
+            .iter()
+            .copied()
+            .filter(|&f| !degenerate(&faces[f as usize]))
+            .collect();
         for w in good.windows(2) {
             union(&mut parent, corner(w[0], a), corner(w[1], a));
             union(&mut parent, corner(w[0], b), corner(w[1], b));
@@ -166,7 +172,10 @@ pub fn check_manifold(n_vertices: usize, faces: &[[u32; 3]]) -> Result<ManifoldR
             }
         }
     }
-    r.non_manifold_vertices = (0..n_vertices).filter(|&v| multi[v]).map(|v| v as u32).collect();
+    r.non_manifold_vertices = (0..n_vertices)
+        .filter(|&v| multi[v])
+        .map(|v| v as u32)
+        .collect();
     r.unreferenced_vertices = referenced.iter().filter(|&&x| !x).count();
     Ok(r)
 }
@@ -205,7 +214,10 @@ mod tests {
         let r = check_manifold(5, &faces).unwrap();
         assert_eq!(r.non_manifold_vertices, vec![0]);
         assert!(!r.is_manifold());
-        assert!(r.to_string().contains("1 vertices with several fans"), "{r}");
+        assert!(
+            r.to_string().contains("1 vertices with several fans"),
+            "{r}"
+        );
 
         // Degenerate face.
         let r = check_manifold(3, &[[0, 1, 1]]).unwrap();

@@ -9,13 +9,16 @@ mod manifold;
 mod topology;
 
 pub use manifold::{check_manifold, ManifoldReport};
-pub use topology::{boundary_loops, EdgeTopology};
+pub use topology::{boundary_loops, EdgeTopology, NO_EDGE};
 
 use crate::error::{GeomError, Result};
 
 /// Fails if a face index is `>= n_vertices`, naming the face.
 pub fn check_indices(n_vertices: usize, faces: &[[u32; 3]]) -> Result<()> {
-    match faces.iter().position(|f| f.iter().any(|&i| i as usize >= n_vertices)) {
+    match faces
+        .iter()
+        .position(|f| f.iter().any(|&i| i as usize >= n_vertices))
+    {
         None => Ok(()),
         Some(fi) => Err(GeomError::InvalidMesh(format!(
             "face {fi} = {:?} has a vertex index out of range ({n_vertices} vertices)",
@@ -166,10 +169,12 @@ pub fn euler_characteristic(n_vertices: usize, faces: &[[u32; 3]]) -> i64 {
 pub fn edge_lengths(vertices: &[glam::Vec3], edges: &[[u32; 2]]) -> Vec<f32> {
     edges
         .iter()
-        .map(|&[a, b]| match (vertices.get(a as usize), vertices.get(b as usize)) {
-            (Some(p), Some(q)) => p.distance(*q),
-            _ => 0.0,
-        })
+        .map(
+            |&[a, b]| match (vertices.get(a as usize), vertices.get(b as usize)) {
+                (Some(p), Some(q)) => p.distance(*q),
+                _ => 0.0,
+            },
+        )
         .collect()
 }
 
@@ -216,7 +221,11 @@ mod tests {
                     }
                 }
             }
-            out.extend((s + 1..n).filter(|&k| dist[k] == 2).map(|k| [s as u32, k as u32]));
+            out.extend(
+                (s + 1..n)
+                    .filter(|&k| dist[k] == 2)
+                    .map(|k| [s as u32, k as u32]),
+            );
         }
         out
     }
@@ -239,6 +248,8 @@ mod tests {
         let g = TriMesh::grid(4, 4, 1.0);
         assert_eq!(euler_characteristic(g.vertices.len(), &g.faces), 1);
         let l = edge_lengths(&g.vertices, &edges(&g.faces));
-        assert!(l.iter().all(|&x| x == 1.0 || (x - 2f32.sqrt()).abs() < 1e-6));
+        assert!(l
+            .iter()
+            .all(|&x| x == 1.0 || (x - 2f32.sqrt()).abs() < 1e-6));
     }
 }

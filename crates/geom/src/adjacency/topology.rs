@@ -51,7 +51,9 @@ impl EdgeTopology {
             while i < inc.len() && inc[i].0 == key {
                 let (_, fi, k) = inc[i];
                 indices.push(fi);
-                forward.push(faces[fi as usize][k as usize] < faces[fi as usize][(k as usize + 1) % 3]);
+                forward.push(
+                    faces[fi as usize][k as usize] < faces[fi as usize][(k as usize + 1) % 3],
+                );
                 face_edges[fi as usize][k as usize] = e;
                 i += 1;
             }
@@ -72,7 +74,10 @@ impl EdgeTopology {
 
     /// Indices of the boundary edges (exactly one incident face), ascending.
     pub fn boundary_edges(&self) -> Vec<u32> {
-        (0..self.edges.len()).filter(|&e| self.faces_of(e).len() == 1).map(|e| e as u32).collect()
+        (0..self.edges.len())
+            .filter(|&e| self.faces_of(e).len() == 1)
+            .map(|e| e as u32)
+            .collect()
     }
 
     /// For every interior edge (exactly two incident faces) `[a, b, c, d]`: the edge `a < b`
@@ -83,7 +88,9 @@ impl EdgeTopology {
         for (e, &[a, b]) in self.edges.iter().enumerate() {
             if let &[f, g] = self.faces_of(e) {
                 let opp = |fi: u32| {
-                    faces.get(fi as usize).and_then(|t| t.iter().copied().find(|&v| v != a && v != b))
+                    faces
+                        .get(fi as usize)
+                        .and_then(|t| t.iter().copied().find(|&v| v != a && v != b))
                 };
                 if let (Some(c), Some(d)) = (opp(f), opp(g)) {
                     out.push([a, b, c, d]);
@@ -116,7 +123,9 @@ pub fn boundary_loops(n_vertices: usize, faces: &[[u32; 3]]) -> Result<Vec<Vec<u
     }
     let mut loops = Vec::new();
     for s in starts {
-        let Some(first) = outgoing.get_mut(&s).and_then(|v| v.pop()) else { continue };
+        let Some(first) = outgoing.get_mut(&s).and_then(|v| v.pop()) else {
+            continue;
+        };
         let mut cycle = vec![s];
         let mut cur = first;
         while cur != s {
@@ -167,7 +176,9 @@ mod tests {
             area += p.z * q.x - p.x * q.z;
         }
         assert!(area > 0.0, "{area}");
-        assert!(boundary_loops(12, &TriMesh::icosphere(0, 1.0).faces).unwrap().is_empty());
+        assert!(boundary_loops(12, &TriMesh::icosphere(0, 1.0).faces)
+            .unwrap()
+            .is_empty());
     }
 
     #[test]
@@ -175,7 +186,11 @@ mod tests {
         // A sphere with two faces removed far apart has two 3-vertex loops.
         let mut s = TriMesh::icosphere(1, 1.0);
         let f0 = s.faces[0];
-        let far = s.faces.iter().rposition(|f| f.iter().all(|v| !f0.contains(v))).unwrap();
+        let far = s
+            .faces
+            .iter()
+            .rposition(|f| f.iter().all(|v| !f0.contains(v)))
+            .unwrap();
         s.faces.remove(far);
         s.faces.remove(0);
         let loops = boundary_loops(s.vertices.len(), &s.faces).unwrap();

@@ -15,7 +15,10 @@ struct Aabb {
 }
 
 impl Aabb {
-    const EMPTY: Aabb = Aabb { min: Vec3::splat(f32::INFINITY), max: Vec3::splat(f32::NEG_INFINITY) };
+    const EMPTY: Aabb = Aabb {
+        min: Vec3::splat(f32::INFINITY),
+        max: Vec3::splat(f32::NEG_INFINITY),
+    };
 
     fn grow(&mut self, o: &Aabb) {
         self.min = self.min.min(o.min);
@@ -65,7 +68,11 @@ pub(super) fn build(vertices: &[Vec3], faces: &[[u32; 3]]) -> (Vec<Node>, Vec<u3
             cbounds.grow_point(centroids[f as usize]);
         }
         if count <= MAX_LEAF {
-            nodes[ni] = Node { start: start as u32, count: count as u32, ..Default::default() };
+            nodes[ni] = Node {
+                start: start as u32,
+                count: count as u32,
+                ..Default::default()
+            };
             continue;
         }
         let mid = match best_split(&order[start..end], &boxes, &centroids, &cbounds) {
@@ -85,7 +92,11 @@ pub(super) fn build(vertices: &[Vec3], faces: &[[u32; 3]]) -> (Vec<Node>, Vec<u3
                 }
             }
             Some(_) => {
-                nodes[ni] = Node { start: start as u32, count: count as u32, ..Default::default() };
+                nodes[ni] = Node {
+                    start: start as u32,
+                    count: count as u32,
+                    ..Default::default()
+                };
                 continue;
             }
             // All centroids coincide: any split is as good as another.
@@ -94,7 +105,11 @@ pub(super) fn build(vertices: &[Vec3], faces: &[[u32; 3]]) -> (Vec<Node>, Vec<u3
         let left = nodes.len();
         nodes.push(Node::default());
         nodes.push(Node::default());
-        nodes[ni] = Node { start: left as u32, count: 0, ..Default::default() };
+        nodes[ni] = Node {
+            start: left as u32,
+            count: 0,
+            ..Default::default()
+        };
         stack.push((left + 1, mid, end));
         stack.push((left, start, mid));
     }
@@ -131,7 +146,13 @@ fn best_split(faces: &[u32], boxes: &[Aabb], centroids: &[Vec3], cb: &Aabb) -> O
         let scale = BINS as f32 / extent;
         let mut bin_box = [Aabb::EMPTY; BINS];
         let mut bin_n = [0usize; BINS];
-        let probe = Split { axis, lo, scale, bin_index: 0, cost: 0.0 };
+        let probe = Split {
+            axis,
+            lo,
+            scale,
+            bin_index: 0,
+            cost: 0.0,
+        };
         for &f in faces {
             let b = probe.bin(centroids[f as usize]);
             bin_box[b].grow(&boxes[f as usize]);
@@ -144,7 +165,11 @@ fn best_split(faces: &[u32], boxes: &[Aabb], centroids: &[Vec3], cb: &Aabb) -> O
         for i in (1..BINS).rev() {
             acc.grow(&bin_box[i]);
             n += bin_n[i];
-            right_cost[i] = if n > 0 { acc.half_area() * n as f32 } else { 0.0 };
+            right_cost[i] = if n > 0 {
+                acc.half_area() * n as f32
+            } else {
+                0.0
+            };
         }
         let mut acc = Aabb::EMPTY;
         let mut n = 0;
@@ -156,7 +181,11 @@ fn best_split(faces: &[u32], boxes: &[Aabb], centroids: &[Vec3], cb: &Aabb) -> O
             }
             let cost = acc.half_area() * n as f32 + right_cost[i];
             if best.is_none_or(|b| cost < b.cost) {
-                best = Some(Split { bin_index: i, cost, ..probe });
+                best = Some(Split {
+                    bin_index: i,
+                    cost,
+                    ..probe
+                });
             }
         }
     }

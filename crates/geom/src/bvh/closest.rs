@@ -65,7 +65,11 @@ impl Bvh {
                 let dl = box_dist2(&self.nodes[l as usize], p);
                 let dr = box_dist2(&self.nodes[r as usize], p);
                 // Push the farther child first so the nearer one is explored first.
-                let (near, dn, far, df) = if dl <= dr { (l, dl, r, dr) } else { (r, dr, l, dl) };
+                let (near, dn, far, df) = if dl <= dr {
+                    (l, dl, r, dr)
+                } else {
+                    (r, dr, l, dl)
+                };
                 if df <= best_d2 {
                     stack.push(far);
                 }
@@ -74,13 +78,21 @@ impl Bvh {
                 }
             }
         }
-        best.map(|(face, point, bary)| ClosestHit { face, point, bary, distance: point.distance(p) })
+        best.map(|(face, point, bary)| ClosestHit {
+            face,
+            point,
+            bary,
+            distance: point.distance(p),
+        })
     }
 
     /// [`Bvh::closest_point_within`] for every point of `points` (`[Q]`), in parallel;
     /// `[Q]` results. Pass `f32::INFINITY` for no distance limit.
     pub fn closest_points(&self, points: &[Vec3], max_distance: f32) -> Vec<Option<ClosestHit>> {
-        points.par_iter().map(|&p| self.closest_point_within(p, max_distance)).collect()
+        points
+            .par_iter()
+            .map(|&p| self.closest_point_within(p, max_distance))
+            .collect()
     }
 }
 
@@ -89,15 +101,22 @@ impl Bvh {
 pub fn closest_point_brute(vertices: &[Vec3], faces: &[[u32; 3]], p: Vec3) -> Option<ClosestHit> {
     let mut best: Option<ClosestHit> = None;
     for (fi, f) in faces.iter().enumerate() {
-        let (Some(&a), Some(&b), Some(&c)) =
-            (vertices.get(f[0] as usize), vertices.get(f[1] as usize), vertices.get(f[2] as usize))
-        else {
+        let (Some(&a), Some(&b), Some(&c)) = (
+            vertices.get(f[0] as usize),
+            vertices.get(f[1] as usize),
+            vertices.get(f[2] as usize),
+        ) else {
             continue;
         };
         let (q, w) = closest_point_on_triangle(p, a, b, c);
         let d = q.distance(p);
         if best.is_none_or(|h| d < h.distance) {
-            best = Some(ClosestHit { face: fi as u32, point: q, bary: w, distance: d });
+            best = Some(ClosestHit {
+                face: fi as u32,
+                point: q,
+                bary: w,
+                distance: d,
+            });
         }
     }
     best
@@ -118,7 +137,12 @@ mod tests {
         for (q, h) in queries.iter().zip(hits) {
             let h = h.unwrap();
             let r = closest_point_brute(&m.vertices, &m.faces, *q).unwrap();
-            assert!((h.distance - r.distance).abs() <= 1e-6, "{q}: {} vs {}", h.distance, r.distance);
+            assert!(
+                (h.distance - r.distance).abs() <= 1e-6,
+                "{q}: {} vs {}",
+                h.distance,
+                r.distance
+            );
             let f = m.faces[h.face as usize].map(|i| m.vertices[i as usize]);
             let rebuilt = h.bary[0] * f[0] + h.bary[1] * f[1] + h.bary[2] * f[2];
             assert!((rebuilt - h.point).length() < 1e-5);
@@ -137,7 +161,11 @@ mod tests {
         assert!(bvh.closest_point_within(p, -1.0).is_none());
         assert!(bvh.closest_point(Vec3::NAN).is_none());
         // Move the mesh; the refitted tree must agree with brute force on the moved mesh.
-        let moved: Vec<Vec3> = m.vertices.iter().map(|v| *v * 1.3 + Vec3::new(0.2, -0.1, 0.4)).collect();
+        let moved: Vec<Vec3> = m
+            .vertices
+            .iter()
+            .map(|v| *v * 1.3 + Vec3::new(0.2, -0.1, 0.4))
+            .collect();
         bvh.refit(&moved).unwrap();
         let mut rng = Rng(5);
         for _ in 0..200 {

@@ -14,9 +14,9 @@ use crate::tri::ray_triangle;
 /// Ray directions: unit vectors far from the axes and from each other, so grid-aligned
 /// meshes do not put edges in their path.
 const DIRS: [Vec3; 3] = [
-    Vec3::new(0.540_606_7, 0.657_192_3, 0.525_296_4),
-    Vec3::new(-0.613_196_2, 0.371_390_7, -0.697_191_5),
-    Vec3::new(0.392_232_1, -0.803_030_7, -0.448_679_8),
+    Vec3::new(0.540_649_2, 0.660_793_4, 0.520_625_1),
+    Vec3::new(-0.610_305_2, 0.370_185_1, -0.700_350_3),
+    Vec3::new(0.391_057_3, -0.802_168_8, -0.451_219_9),
 ];
 
 /// Whether the ray `o + t d`, `t in [0, t_max]`, meets the box of `n`.
@@ -100,7 +100,10 @@ impl Bvh {
     /// [`Bvh::signed_distance`] for every point of `points` (`[Q]`), in parallel; `[Q]`
     /// results, NaN where the distance is undefined (empty mesh, non-finite point).
     pub fn signed_distances(&self, points: &[Vec3]) -> Vec<f32> {
-        points.par_iter().map(|&p| self.signed_distance(p).unwrap_or(f32::NAN)).collect()
+        points
+            .par_iter()
+            .map(|&p| self.signed_distance(p).unwrap_or(f32::NAN))
+            .collect()
     }
 }
 

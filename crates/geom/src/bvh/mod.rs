@@ -71,10 +71,18 @@ impl Bvh {
         check_vertices(vertices)?;
         crate::adjacency::check_indices(vertices.len(), faces)?;
         if faces.len() >= u32::MAX as usize / 2 {
-            return Err(GeomError::InvalidMesh(format!("{} faces are too many", faces.len())));
+            return Err(GeomError::InvalidMesh(format!(
+                "{} faces are too many",
+                faces.len()
+            )));
         }
         let (nodes, order) = build::build(vertices, faces);
-        let mut bvh = Bvh { vertices: vertices.to_vec(), faces: faces.to_vec(), nodes, order };
+        let mut bvh = Bvh {
+            vertices: vertices.to_vec(),
+            faces: faces.to_vec(),
+            nodes,
+            order,
+        };
         bvh.refit_bounds();
         Ok(bvh)
     }
@@ -120,7 +128,10 @@ impl Bvh {
                 let pad = 1e-6 * (1.0 + lo.abs().max(hi.abs()).max_element());
                 (lo - Vec3::splat(pad), hi + Vec3::splat(pad))
             } else {
-                let (l, r) = (self.nodes[n.start as usize], self.nodes[n.start as usize + 1]);
+                let (l, r) = (
+                    self.nodes[n.start as usize],
+                    self.nodes[n.start as usize + 1],
+                );
                 (l.min.min(r.min), l.max.max(r.max))
             };
             self.nodes[i].min = lo;
@@ -191,7 +202,12 @@ pub(crate) mod tests {
             (z >> 40) as f32 / (1u64 << 24) as f32
         }
         pub(crate) fn vec3(&mut self, scale: f32) -> Vec3 {
-            Vec3::new(self.next_f32() - 0.5, self.next_f32() - 0.5, self.next_f32() - 0.5) * 2.0 * scale
+            Vec3::new(
+                self.next_f32() - 0.5,
+                self.next_f32() - 0.5,
+                self.next_f32() - 0.5,
+            ) * 2.0
+                * scale
         }
     }
 

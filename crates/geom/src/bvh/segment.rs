@@ -74,6 +74,15 @@ impl Bvh {
         out
     }
 
+    /// Indices of the faces crossed by the segment `[a, b]`, ordered along the segment (the
+    /// faces of [`Bvh::segment_hits`] with no vertex skipped).
+    pub fn segment_faces(&self, a: Vec3, b: Vec3) -> Vec<u32> {
+        self.segment_hits(a, b, &[])
+            .into_iter()
+            .map(|h| h.face)
+            .collect()
+    }
+
     /// Whether the segment `[a, b]` crosses any face not touching `skip_vertices`
     /// (stops at the first crossing).
     pub fn segment_intersects(&self, a: Vec3, b: Vec3, skip_vertices: &[u32]) -> bool {
@@ -126,13 +135,19 @@ pub fn segment_hits_brute(
         if f.iter().any(|v| skip_vertices.contains(v)) {
             continue;
         }
-        let (Some(&p), Some(&q), Some(&r)) =
-            (vertices.get(f[0] as usize), vertices.get(f[1] as usize), vertices.get(f[2] as usize))
-        else {
+        let (Some(&p), Some(&q), Some(&r)) = (
+            vertices.get(f[0] as usize),
+            vertices.get(f[1] as usize),
+            vertices.get(f[2] as usize),
+        ) else {
             continue;
         };
         if let Some((t, bary)) = segment_triangle(a, b, p, q, r) {
-            out.push(SegmentHit { face: fi as u32, t, bary });
+            out.push(SegmentHit {
+                face: fi as u32,
+                t,
+                bary,
+            });
         }
     }
     out.sort_by(|x, y| x.t.total_cmp(&y.t).then(x.face.cmp(&y.face)));
@@ -154,12 +169,24 @@ mod tests {
         let mut total = 0;
         for i in 0..400 {
             let a = rng.vec3(1.5);
-            let b = if i % 2 == 0 { a + rng.vec3(0.3) } else { rng.vec3(1.5) };
-            let skip = if i % 3 == 0 { vec![m.faces[i][0], m.faces[i + 1][1]] } else { vec![] };
+            let b = if i % 2 == 0 {
+                a + rng.vec3(0.3)
+            } else {
+                rng.vec3(1.5)
+            };
+            let skip = if i % 3 == 0 {
+                vec![m.faces[i][0], m.faces[i + 1][1]]
+            } else {
+                vec![]
+            };
             let got = bvh.segment_hits(a, b, &skip);
             let want = segment_hits_brute(&m.vertices, &m.faces, a, b, &skip);
             assert_eq!(got, want, "segment {a} -> {b}");
             assert_eq!(bvh.segment_intersects(a, b, &skip), !want.is_empty());
+            if skip.is_empty() {
+                let faces: Vec<u32> = want.iter().map(|h| h.face).collect();
+                assert_eq!(bvh.segment_faces(a, b), faces);
+            }
             total += want.len();
         }
         assert!(total > 100, "too few crossings to be a test: {total}");
@@ -173,7 +200,9 @@ mod tests {
         let h = bvh.segment_hits(Vec3::new(0.3, 0.2, -2.0), Vec3::new(0.3, 0.2, 2.0), &[]);
         assert_eq!(h.len(), 2);
         assert!((h[0].t - 0.25).abs() < 1e-6 && (h[1].t - 0.75).abs() < 1e-6);
-        assert!(bvh.segment_hits(Vec3::new(0.3, 0.2, -0.5), Vec3::new(0.3, 0.2, 0.5), &[]).is_empty());
+        assert!(bvh
+            .segment_hits(Vec3::new(0.3, 0.2, -0.5), Vec3::new(0.3, 0.2, 0.5), &[])
+            .is_empty());
     }
 
     #[test]

@@ -71,8 +71,10 @@ mod tests {
     use super::*;
 
     fn entries(dir: &Path) -> Vec<String> {
-        let mut v: Vec<_> =
-            fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        let mut v: Vec<_> = fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
         v.sort();
         v
     }
@@ -97,7 +99,10 @@ mod tests {
             Err(io::Error::other("boom"))
         })
         .unwrap_err();
-        assert!(e.to_string().contains("a.txt") && e.to_string().contains("boom"), "{e}");
+        assert!(
+            e.to_string().contains("a.txt") && e.to_string().contains("boom"),
+            "{e}"
+        );
         assert_eq!(fs::read(&p).unwrap(), b"old");
         assert_eq!(entries(d.path()), vec!["a.txt"]);
     }

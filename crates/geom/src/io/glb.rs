@@ -41,6 +41,12 @@ const FLOAT: u32 = 5126;
 const UNSIGNED_INT: u32 = 5125;
 const TRIANGLES: u32 = 4;
 
+/// The f32 components as f64 so the JSON holds their exact values: validators compare
+/// accessor min/max with the data read as doubles.
+fn exact(v: Vec3) -> [f64; 3] {
+    v.as_dvec3().to_array()
+}
+
 fn push_vec3s(bin: &mut Vec<u8>, vs: impl Iterator<Item = Vec3>) {
     for v in vs {
         for c in v.to_array() {
@@ -53,16 +59,22 @@ fn push_vec3s(bin: &mut Vec<u8>, vs: impl Iterator<Item = Vec3>) {
 /// not validate, or a colour component is outside [0, 1].
 pub fn encode_glb(meshes: &[GlbMesh]) -> Result<Vec<u8>> {
     if meshes.is_empty() {
-        return Err(GeomError::InvalidInput("GLB needs at least one mesh".into()));
+        return Err(GeomError::InvalidInput(
+            "GLB needs at least one mesh".into(),
+        ));
     }
     let mut bin: Vec<u8> = Vec::new();
     let (mut views, mut accessors, mut gmeshes, mut materials, mut nodes) =
         (vec![], vec![], vec![], vec![], vec![]);
     for (i, m) in meshes.iter().enumerate() {
         let mesh = m.mesh;
-        mesh.validate().map_err(|e| GeomError::InvalidInput(format!("GLB mesh {i} ({}): {e}", m.name)))?;
+        mesh.validate()
+            .map_err(|e| GeomError::InvalidInput(format!("GLB mesh {i} ({}): {e}", m.name)))?;
         if mesh.faces.is_empty() {
-            return Err(GeomError::InvalidInput(format!("GLB mesh {i} ({}) has no faces", m.name)));
+            return Err(GeomError::InvalidInput(format!(
+                "GLB mesh {i} ({}) has no faces",
+                m.name
+            )));
         }
         if m.color.iter().any(|c| !(0.0..=1.0).contains(c)) {
             return Err(GeomError::InvalidInput(format!(
@@ -77,28 +89,47 @@ pub fn encode_glb(meshes: &[GlbMesh]) -> Result<Vec<u8>> {
         // Positions.
         let off = bin.len();
         push_vec3s(&mut bin, mesh.vertices.iter().copied());
-        views.push(json!({"buffer": 0, "byteOffset": off, "byteLength": 12 * n, "target": ARRAY_BUFFER}));
+        views.push(
+            json!({"buffer": 0, "byteOffset": off, "byteLength": 12 * n, "target": ARRAY_BUFFER}),
+        );
         // Normals (zero normals of isolated or degenerate vertices become +Y: glTF wants unit).
         let off = bin.len();
-        push_vec3s(&mut bin, normals.iter().map(|&v| if v == Vec3::ZERO { Vec3::Y } else { v }));
-        views.push(json!({"buffer": 0, "byteOffset": off, "byteLength": 12 * n, "target": ARRAY_BUFFER}));
+        push_vec3s(
+            &mut bin,
+            normals
+                .iter()
+                .map(|&v| if v == Vec3::ZERO { Vec3::Y } else { v }),
+        );
+        views.push(
+            json!({"buffer": 0, "byteOffset": off, "byteLength": 12 * n, "target": ARRAY_BUFFER}),
+        );
         // Indices.
         let off = bin.len();
         for &i in mesh.faces.as_flattened() {
             bin.extend_from_slice(&i.to_le_bytes());
         }
-        views.push(json!({"buffer": 0, "byteOffset": off, "byteLength": 12 * mesh.faces.len(),
-                          "target": ELEMENT_ARRAY_BUFFER}));
-        accessors.push(json!({"bufferView": base, "componentType": FLOAT, "count": n, "type": "VEC3",
-                              "min": lo.to_array(), "max": hi.to_array()}));
-        accessors.push(json!({"bufferView": base + 1, "componentType": FLOAT, "count": n, "type": "VEC3"}));
-        accessors.push(json!({"bufferView": base + 2, "componentType": UNSIGNED_INT,
-                              "count": 3 * mesh.faces.len(), "type": "SCALAR"}));
+        views.push(
+            json!({"buffer": 0, "byteOffset": off, "byteLength": 12 * mesh.faces.len(),
+                          "target": ELEMENT_ARRAY_BUFFER}),
+        );
+        accessors.push(
+            json!({"bufferView": base, "componentType": FLOAT, "count": n, "type": "VEC3",
+                              "min": exact(lo), "max": exact(hi)}),
+        );
+        accessors.push(
+            json!({"bufferView": base + 1, "componentType": FLOAT, "count": n, "type": "VEC3"}),
+        );
+        accessors.push(
+            json!({"bufferView": base + 2, "componentType": UNSIGNED_INT,
+                              "count": 3 * mesh.faces.len(), "type": "SCALAR"}),
+        );
         gmeshes.push(json!({"name": m.name, "primitives": [{
             "attributes": {"POSITION": base, "NORMAL": base + 1},
             "indices": base + 2, "material": i, "mode": TRIANGLES}]}));
-        materials.push(json!({"name": m.name, "doubleSided": true, "pbrMetallicRoughness": {
-            "baseColorFactor": m.color, "metallicFactor": 0.0, "roughnessFactor": 0.8}}));
+        materials.push(
+            json!({"name": m.name, "doubleSided": true, "pbrMetallicRoughness": {
+            "baseColorFactor": m.color, "metallicFactor": 0.0, "roughnessFactor": 0.8}}),
+        );
         nodes.push(json!({"name": m.name, "mesh": i}));
     }
     let doc = json!({
@@ -154,8 +185,16 @@ mod tests {
         let s = TriMesh::icosphere(1, 0.5);
         let g = TriMesh::grid(3, 2, 0.1);
         let bytes = encode_glb(&[
-            GlbMesh { mesh: &s, name: "sphere", color: [1.0, 0.0, 0.0, 1.0] },
-            GlbMesh { mesh: &g, name: "sheet", color: DEFAULT_COLOR },
+            GlbMesh {
+                mesh: &s,
+                name: "sphere",
+                color: [1.0, 0.0, 0.0, 1.0],
+            },
+            GlbMesh {
+                mesh: &g,
+                name: "sheet",
+                color: DEFAULT_COLOR,
+            },
         ])
         .unwrap();
         assert_eq!(bytes.len() % 4, 0);
@@ -165,7 +204,10 @@ mod tests {
         let jlen = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
         assert_eq!(jlen % 4, 0);
         let doc: Value = serde_json::from_slice(&bytes[20..20 + jlen]).unwrap();
-        assert_eq!(doc["accessors"][0]["max"][1].as_f64().unwrap() as f32, s.bounds().unwrap().1.y);
+        assert_eq!(
+            doc["accessors"][0]["max"][1].as_f64().unwrap() as f32,
+            s.bounds().unwrap().1.y
+        );
         assert_eq!(doc["materials"][1]["doubleSided"], true);
         for v in doc["bufferViews"].as_array().unwrap() {
             assert_eq!(v["byteOffset"].as_u64().unwrap() % 4, 0);
@@ -178,11 +220,26 @@ mod tests {
     fn rejects_bad_input() {
         assert!(encode_glb(&[]).is_err());
         let empty = TriMesh::default();
-        assert!(encode_glb(&[GlbMesh { mesh: &empty, name: "e", color: DEFAULT_COLOR }]).is_err());
+        assert!(encode_glb(&[GlbMesh {
+            mesh: &empty,
+            name: "e",
+            color: DEFAULT_COLOR
+        }])
+        .is_err());
         let mut nan = TriMesh::icosphere(0, 1.0);
         nan.vertices[0].x = f32::NAN;
-        assert!(encode_glb(&[GlbMesh { mesh: &nan, name: "n", color: DEFAULT_COLOR }]).is_err());
+        assert!(encode_glb(&[GlbMesh {
+            mesh: &nan,
+            name: "n",
+            color: DEFAULT_COLOR
+        }])
+        .is_err());
         let s = TriMesh::icosphere(0, 1.0);
-        assert!(encode_glb(&[GlbMesh { mesh: &s, name: "c", color: [2.0, 0.0, 0.0, 1.0] }]).is_err());
+        assert!(encode_glb(&[GlbMesh {
+            mesh: &s,
+            name: "c",
+            color: [2.0, 0.0, 0.0, 1.0]
+        }])
+        .is_err());
     }
 }

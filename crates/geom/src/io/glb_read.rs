@@ -39,19 +39,37 @@ fn u32_at(b: &[u8], at: usize) -> Option<u32> {
 fn container<'a>(bytes: &'a [u8], path: &Path) -> Result<(Value, Option<&'a [u8]>)> {
     let berr = |off: usize, msg: String| GeomError::binary(path, off as u64, msg);
     if bytes.len() < 12 {
-        return Err(berr(bytes.len(), format!("file is {} bytes, a GLB header needs 12", bytes.len())));
+        return Err(berr(
+            bytes.len(),
+            format!("file is {} bytes, a GLB header needs 12", bytes.len()),
+        ));
     }
     let magic = u32_at(bytes, 0).unwrap_or(0);
     if magic != GLB_MAGIC {
-        return Err(berr(0, format!("bad magic {:?} (expected \"glTF\")", String::from_utf8_lossy(&bytes[..4]))));
+        return Err(berr(
+            0,
+            format!(
+                "bad magic {:?} (expected \"glTF\")",
+                String::from_utf8_lossy(&bytes[..4])
+            ),
+        ));
     }
     let version = u32_at(bytes, 4).unwrap_or(0);
     if version != 2 {
-        return Err(berr(4, format!("unsupported glTF container version {version}")));
+        return Err(berr(
+            4,
+            format!("unsupported glTF container version {version}"),
+        ));
     }
     let total = u32_at(bytes, 8).unwrap_or(0) as usize;
     if total > bytes.len() {
-        return Err(berr(8, format!("header declares {total} bytes but the file has {}", bytes.len())));
+        return Err(berr(
+            8,
+            format!(
+                "header declares {total} bytes but the file has {}",
+                bytes.len()
+            ),
+        ));
     }
     let bytes = &bytes[..total];
     let mut pos = 12;
@@ -62,9 +80,18 @@ fn container<'a>(bytes: &'a [u8], path: &Path) -> Result<(Value, Option<&'a [u8]
             return Err(berr(pos, "truncated chunk header".into()));
         };
         let start = pos + 8;
-        let end = start.checked_add(len as usize).filter(|&e| e <= bytes.len()).ok_or_else(|| {
-            berr(pos, format!("chunk of {len} bytes runs past the end of the file ({} bytes)", bytes.len()))
-        })?;
+        let end = start
+            .checked_add(len as usize)
+            .filter(|&e| e <= bytes.len())
+            .ok_or_else(|| {
+                berr(
+                    pos,
+                    format!(
+                        "chunk of {len} bytes runs past the end of the file ({} bytes)",
+                        bytes.len()
+                    ),
+                )
+            })?;
         let data = &bytes[start..end];
         match kind {
             CHUNK_JSON if json.is_none() => {
@@ -109,12 +136,20 @@ impl Doc<'_> {
     fn buffer(&self, i: usize) -> Result<&[u8]> {
         let b = self.item("buffers", i)?;
         if i != 0 || b.get("uri").is_some() {
-            return Err(self.err(format!("buffers[{i}]: only the embedded GLB buffer is supported")));
+            return Err(self.err(format!(
+                "buffers[{i}]: only the embedded GLB buffer is supported"
+            )));
         }
-        let bin = self.bin.ok_or_else(|| self.err("buffers[0] but no BIN chunk".into()))?;
-        let len = idx(b, "byteLength").ok_or_else(|| self.err("buffers[0] has no byteLength".into()))?;
+        let bin = self
+            .bin
+            .ok_or_else(|| self.err("buffers[0] but no BIN chunk".into()))?;
+        let len =
+            idx(b, "byteLength").ok_or_else(|| self.err("buffers[0] has no byteLength".into()))?;
         bin.get(..len).ok_or_else(|| {
-            self.err(format!("buffers[0] byteLength {len} exceeds the BIN chunk ({} bytes)", bin.len()))
+            self.err(format!(
+                "buffers[0] byteLength {len} exceeds the BIN chunk ({} bytes)",
+                bin.len()
+            ))
         })
     }
 
@@ -131,7 +166,10 @@ impl Doc<'_> {
             return Err(e(&format!("type {ty:?}, expected {want_type:?}")));
         }
         let comps = if ty == "VEC3" { 3 } else { 1 };
-        let ct = acc.get("componentType").and_then(Value::as_u64).unwrap_or(0);
+        let ct = acc
+            .get("componentType")
+            .and_then(Value::as_u64)
+            .unwrap_or(0);
         if !allowed.contains(&ct) {
             return Err(e(&format!("componentType {ct} not supported here")));
         }
@@ -142,7 +180,13 @@ impl Doc<'_> {
         };
         let count = idx(acc, "count").ok_or_else(|| e("no count"))?;
         let Some(view_i) = idx(acc, "bufferView") else {
-            return Ok(vec![0.0; count.saturating_mul(comps).min(1 << 28)]);
+            // No buffer view: all zeros (rare; bounded so a bogus count cannot exhaust memory).
+            if count > 1 << 24 {
+                return Err(e(&format!(
+                    "count {count} without a buffer view is implausible"
+                )));
+            }
+            return Ok(vec![0.0; count * comps]);
         };
         let view = self.item("bufferViews", view_i)?;
         let buf = self.buffer(idx(view, "buffer").unwrap_or(usize::MAX))?;
@@ -155,13 +199,16 @@ impl Doc<'_> {
         let elem = csize * comps;
         let stride = idx(view, "byteStride").unwrap_or(elem);
         if stride < elem {
-            return Err(e(&format!("byteStride {stride} smaller than the element ({elem} bytes)")));
+            return Err(e(&format!(
+                "byteStride {stride} smaller than the element ({elem} bytes)"
+            )));
         }
         let aoff = idx(acc, "byteOffset").unwrap_or(0);
         if count > 0 {
             let need = (count - 1)
                 .checked_mul(stride)
-                .and_then(|x| x.checked_add(aoff + elem))
+                .and_then(|x| x.checked_add(aoff))
+                .and_then(|x| x.checked_add(elem))
                 .ok_or_else(|| e("size overflow"))?;
             if need > vdata.len() {
                 return Err(e(&format!(
@@ -202,18 +249,28 @@ impl Doc<'_> {
         if let Some(m) = nums("matrix", 16) {
             return Ok(Mat4::from_cols_slice(&m?));
         }
-        let t = nums("translation", 3).transpose()?.map_or(Vec3::ZERO, |v| Vec3::from_slice(&v));
+        let t = nums("translation", 3)
+            .transpose()?
+            .map_or(Vec3::ZERO, |v| Vec3::from_slice(&v));
         let r = nums("rotation", 4)
             .transpose()?
-            .map_or(Quat::IDENTITY, |v| Quat::from_xyzw(v[0], v[1], v[2], v[3]).normalize());
-        let s = nums("scale", 3).transpose()?.map_or(Vec3::ONE, |v| Vec3::from_slice(&v));
+            .map_or(Quat::IDENTITY, |v| {
+                Quat::from_xyzw(v[0], v[1], v[2], v[3]).normalize()
+            });
+        let s = nums("scale", 3)
+            .transpose()?
+            .map_or(Vec3::ONE, |v| Vec3::from_slice(&v));
         Ok(Mat4::from_scale_rotation_translation(s, r, t))
     }
 
     fn primitives_of(&self, mi: usize, xf: Mat4, out: &mut Vec<GlbPrimitive>) -> Result<()> {
         let mesh = self.item("meshes", mi)?;
         let name = mesh.get("name").and_then(Value::as_str).map(str::to_string);
-        let prims = mesh.get("primitives").and_then(Value::as_array).cloned().unwrap_or_default();
+        let prims = mesh
+            .get("primitives")
+            .and_then(Value::as_array)
+            .cloned()
+            .unwrap_or_default();
         for (pi, prim) in prims.iter().enumerate() {
             let mode = prim.get("mode").and_then(Value::as_u64).unwrap_or(4);
             if !(4..=6).contains(&mode) {
@@ -246,16 +303,29 @@ impl Doc<'_> {
             let faces: Vec<[u32; 3]> = match mode {
                 4 => ids.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
                 5 => (0..ids.len().saturating_sub(2))
-                    .map(|i| if i % 2 == 0 { [ids[i], ids[i + 1], ids[i + 2]] } else { [ids[i], ids[i + 2], ids[i + 1]] })
+                    .map(|i| {
+                        if i % 2 == 0 {
+                            [ids[i], ids[i + 1], ids[i + 2]]
+                        } else {
+                            [ids[i], ids[i + 2], ids[i + 1]]
+                        }
+                    })
                     .collect(),
-                _ => (1..ids.len().saturating_sub(1)).map(|i| [ids[i], ids[i + 1], ids[0]]).collect(),
+                _ => (1..ids.len().saturating_sub(1))
+                    .map(|i| [ids[i], ids[i + 1], ids[0]])
+                    .collect(),
             };
             let base_color = idx(prim, "material").and_then(|m| {
-                let c = self.json.get("materials")?.get(m)?.get("pbrMetallicRoughness")?;
+                let c = self
+                    .json
+                    .get("materials")?
+                    .get(m)?
+                    .get("pbrMetallicRoughness")?;
                 let f = c.get("baseColorFactor").and_then(Value::as_array);
                 match f {
                     Some(a) if a.len() == 4 => {
-                        let v: Vec<f32> = a.iter().map(|x| x.as_f64().unwrap_or(1.0) as f32).collect();
+                        let v: Vec<f32> =
+                            a.iter().map(|x| x.as_f64().unwrap_or(1.0) as f32).collect();
                         Some([v[0], v[1], v[2], v[3]])
                     }
                     _ => Some([1.0; 4]),
@@ -272,10 +342,21 @@ impl Doc<'_> {
         Ok(())
     }
 
-    fn visit(&self, ni: usize, parent: Mat4, depth: usize, out: &mut Vec<GlbPrimitive>) -> Result<()> {
+    fn visit(
+        &self,
+        ni: usize,
+        parent: Mat4,
+        depth: usize,
+        budget: &mut usize,
+        out: &mut Vec<GlbPrimitive>,
+    ) -> Result<()> {
         if depth > 64 {
             return Err(self.err("node hierarchy deeper than 64 (a cycle?)".into()));
         }
+        // Shared children make the hierarchy a DAG: bound the total work on hostile files.
+        *budget = budget
+            .checked_sub(1)
+            .ok_or_else(|| self.err("too many node instances".into()))?;
         let node = self.item("nodes", ni)?;
         let xf = parent * self.node_matrix(node)?;
         if let Some(mi) = idx(node, "mesh") {
@@ -283,8 +364,10 @@ impl Doc<'_> {
         }
         if let Some(children) = node.get("children").and_then(Value::as_array) {
             for c in children {
-                let c = c.as_u64().ok_or_else(|| self.err(format!("nodes[{ni}]: bad child")))?;
-                self.visit(c as usize, xf, depth + 1, out)?;
+                let c = c
+                    .as_u64()
+                    .ok_or_else(|| self.err(format!("nodes[{ni}]: bad child")))?;
+                self.visit(c as usize, xf, depth + 1, budget, out)?;
             }
         }
         Ok(())
@@ -300,14 +383,25 @@ pub fn parse_glb(bytes: &[u8], path: &Path) -> Result<Vec<GlbPrimitive>> {
     let scene_i = idx(&doc.json, "scene").unwrap_or(0);
     match doc.json.get("scenes").and_then(|s| s.get(scene_i)) {
         Some(scene) => {
-            let roots = scene.get("nodes").and_then(Value::as_array).cloned().unwrap_or_default();
+            let roots = scene
+                .get("nodes")
+                .and_then(Value::as_array)
+                .cloned()
+                .unwrap_or_default();
+            let mut budget = 1 << 16;
             for r in roots {
-                let r = r.as_u64().ok_or_else(|| doc.err("scene lists a bad node".into()))?;
-                doc.visit(r as usize, Mat4::IDENTITY, 0, &mut out)?;
+                let r = r
+                    .as_u64()
+                    .ok_or_else(|| doc.err("scene lists a bad node".into()))?;
+                doc.visit(r as usize, Mat4::IDENTITY, 0, &mut budget, &mut out)?;
             }
         }
         None => {
-            let n = doc.json.get("meshes").and_then(Value::as_array).map_or(0, Vec::len);
+            let n = doc
+                .json
+                .get("meshes")
+                .and_then(Value::as_array)
+                .map_or(0, Vec::len);
             for mi in 0..n {
                 doc.primitives_of(mi, Mat4::IDENTITY, &mut out)?;
             }
@@ -328,7 +422,8 @@ pub fn read_glb_merged(path: impl AsRef<Path>) -> Result<TriMesh> {
     let path = path.as_ref();
     let mut out = TriMesh::default();
     for p in read_glb(path)? {
-        out.append(&p.mesh).map_err(|e| GeomError::format(path, e.to_string()))?;
+        out.append(&p.mesh)
+            .map_err(|e| GeomError::format(path, e.to_string()))?;
     }
     Ok(out)
 }
@@ -348,8 +443,16 @@ mod tests {
         let s = TriMesh::icosphere(1, 0.5);
         let g = TriMesh::grid(3, 2, 0.1);
         let bytes = encode_glb(&[
-            GlbMesh { mesh: &s, name: "sphere", color: [1.0, 0.0, 0.0, 1.0] },
-            GlbMesh { mesh: &g, name: "sheet", color: DEFAULT_COLOR },
+            GlbMesh {
+                mesh: &s,
+                name: "sphere",
+                color: [1.0, 0.0, 0.0, 1.0],
+            },
+            GlbMesh {
+                mesh: &g,
+                name: "sheet",
+                color: DEFAULT_COLOR,
+            },
         ])
         .unwrap();
         let prims = parse_glb(&bytes, p()).unwrap();
@@ -388,12 +491,19 @@ mod tests {
     #[test]
     fn errors() {
         let s = TriMesh::icosphere(0, 1.0);
-        let good = encode_glb(&[GlbMesh { mesh: &s, name: "s", color: DEFAULT_COLOR }]).unwrap();
+        let good = encode_glb(&[GlbMesh {
+            mesh: &s,
+            name: "s",
+            color: DEFAULT_COLOR,
+        }])
+        .unwrap();
         let mut bad = good.clone();
         bad[0] = b'x';
         let e = parse_glb(&bad, p()).unwrap_err().to_string();
         assert!(e.contains("t.glb: byte 0") && e.contains("magic"), "{e}");
-        let e = parse_glb(&good[..good.len() - 10], p()).unwrap_err().to_string();
+        let e = parse_glb(&good[..good.len() - 10], p())
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("byte 8"), "{e}");
         let mut cut = good[..good.len() - 10].to_vec();
         let n = cut.len() as u32;
@@ -406,13 +516,17 @@ mod tests {
             "accessors": [{"bufferView": 0, "componentType": 5126, "count": 1, "type": "VEC3"},
                           {"bufferView": 0, "componentType": 5121, "count": 3, "type": "SCALAR"}],
             "bufferViews": [{"buffer": 0, "byteLength": 12}], "buffers": [{"byteLength": 12}]});
-        let e = parse_glb(&assemble(&doc, &[0x40; 12]), p()).unwrap_err().to_string();
+        let e = parse_glb(&assemble(&doc, &[0x40; 12]), p())
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("out of range"), "{e}");
         // Accessor past its view.
         let doc = json!({"meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
             "accessors": [{"bufferView": 0, "componentType": 5126, "count": 2, "type": "VEC3"}],
             "bufferViews": [{"buffer": 0, "byteLength": 12}], "buffers": [{"byteLength": 12}]});
-        let e = parse_glb(&assemble(&doc, &[0; 12]), p()).unwrap_err().to_string();
+        let e = parse_glb(&assemble(&doc, &[0; 12]), p())
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("accessors[0]"), "{e}");
     }
 }

@@ -34,7 +34,10 @@ pub enum MeshFormat {
 impl MeshFormat {
     /// The format of `path` by its (case-insensitive) extension.
     pub fn from_path(path: &Path) -> Result<MeshFormat> {
-        let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
         match ext.as_deref() {
             Some("obj") => Ok(MeshFormat::Obj),
             Some("ply") => Ok(MeshFormat::Ply),
@@ -67,7 +70,14 @@ pub fn write_mesh(path: impl AsRef<Path>, mesh: &TriMesh) -> Result<()> {
         MeshFormat::Ply => write_ply(path, mesh),
         MeshFormat::Glb => {
             let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("mesh");
-            write_glb(path, &[GlbMesh { mesh, name, color: DEFAULT_COLOR }])
+            write_glb(
+                path,
+                &[GlbMesh {
+                    mesh,
+                    name,
+                    color: DEFAULT_COLOR,
+                }],
+            )
         }
     }
 }
@@ -85,9 +95,13 @@ mod tests {
             write_mesh(&p, &m).unwrap();
             assert_eq!(read_mesh(&p).unwrap(), m, "{ext}");
         }
-        let e = write_mesh(d.path().join("m.stl"), &m).unwrap_err().to_string();
+        let e = write_mesh(d.path().join("m.stl"), &m)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("m.stl"), "{e}");
-        let e = read_mesh(d.path().join("missing.obj")).unwrap_err().to_string();
+        let e = read_mesh(d.path().join("missing.obj"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("missing.obj"), "{e}");
     }
 }

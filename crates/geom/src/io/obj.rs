@@ -40,9 +40,38 @@ pub struct ObjData {
 
 /// Statements that are valid OBJ but carry nothing we use.
 const IGNORED: &[&str] = &[
-    "vn", "vp", "o", "s", "usemtl", "mtllib", "l", "p", "cstype", "deg", "bmat", "step", "curv",
-    "curv2", "surf", "parm", "trim", "hole", "scrv", "sp", "end", "con", "mg", "bevel",
-    "c_interp", "d_interp", "lod", "maplib", "usemap", "shadow_obj", "trace_obj", "ctech",
+    "vn",
+    "vp",
+    "o",
+    "s",
+    "usemtl",
+    "mtllib",
+    "l",
+    "p",
+    "cstype",
+    "deg",
+    "bmat",
+    "step",
+    "curv",
+    "curv2",
+    "surf",
+    "parm",
+    "trim",
+    "hole",
+    "scrv",
+    "sp",
+    "end",
+    "con",
+    "mg",
+    "bevel",
+    "c_interp",
+    "d_interp",
+    "lod",
+    "maplib",
+    "usemap",
+    "shadow_obj",
+    "trace_obj",
+    "ctech",
     "stech",
 ];
 
@@ -65,7 +94,11 @@ fn parse_f32(tok: Option<&str>, what: &str, path: &Path, line: usize) -> Result<
         .parse()
         .map_err(|_| GeomError::text(path, line, format!("{what} {tok:?} is not a number")))?;
     if !x.is_finite() {
-        return Err(GeomError::text(path, line, format!("{what} {tok:?} is not finite")));
+        return Err(GeomError::text(
+            path,
+            line,
+            format!("{what} {tok:?} is not finite"),
+        ));
     }
     Ok(x)
 }
@@ -74,14 +107,22 @@ fn parse_f32(tok: Option<&str>, what: &str, path: &Path, line: usize) -> Result<
 /// Positive indices may point forward (checked at the end of the file).
 fn resolve(tok: &str, count: usize, what: &str, path: &Path, line: usize) -> Result<u32> {
     let i: i64 = tok.parse().map_err(|_| {
-        GeomError::text(path, line, format!("{what} index {tok:?} is not an integer"))
+        GeomError::text(
+            path,
+            line,
+            format!("{what} index {tok:?} is not an integer"),
+        )
     })?;
     let r = if i > 0 {
         i - 1
     } else if i < 0 {
         count as i64 + i
     } else {
-        return Err(GeomError::text(path, line, format!("{what} index 0 (OBJ indices start at 1)")));
+        return Err(GeomError::text(
+            path,
+            line,
+            format!("{what} index 0 (OBJ indices start at 1)"),
+        ));
     };
     if r < 0 || r >= u32::MAX as i64 {
         return Err(GeomError::text(
@@ -140,7 +181,13 @@ pub fn parse_obj(text: &str, path: &Path) -> Result<ObjData> {
                             format!("face vertex {tok:?} has no position index"),
                         ));
                     }
-                    poly.push(resolve(vtok, out.mesh.vertices.len(), "vertex", path, line)?);
+                    poly.push(resolve(
+                        vtok,
+                        out.mesh.vertices.len(),
+                        "vertex",
+                        path,
+                        line,
+                    )?);
                     match parts.next() {
                         Some(t) if !t.is_empty() => {
                             poly_t.push(resolve(t, out.texcoords.len(), "texcoord", path, line)?)
@@ -176,7 +223,11 @@ pub fn parse_obj(text: &str, path: &Path) -> Result<ObjData> {
                 }
                 all_textured &= textured;
                 let max_v = poly.iter().copied().max().unwrap_or(0);
-                let max_t = if textured { poly_t.iter().copied().max() } else { None };
+                let max_t = if textured {
+                    poly_t.iter().copied().max()
+                } else {
+                    None
+                };
                 max_refs.push((line, max_v, max_t));
                 for i in 1..poly.len() - 1 {
                     out.mesh.faces.push([poly[0], poly[i], poly[i + 1]]);
@@ -191,11 +242,18 @@ pub fn parse_obj(text: &str, path: &Path) -> Result<ObjData> {
                     last.faces.end = nfaces;
                 }
                 let name = toks.collect::<Vec<_>>().join(" ");
-                out.groups.push(ObjGroup { name, faces: nfaces..nfaces });
+                out.groups.push(ObjGroup {
+                    name,
+                    faces: nfaces..nfaces,
+                });
             }
             k if IGNORED.contains(&k) => {}
             k => {
-                return Err(GeomError::text(path, line, format!("unknown statement {k:?}")));
+                return Err(GeomError::text(
+                    path,
+                    line,
+                    format!("unknown statement {k:?}"),
+                ));
             }
         }
     }
@@ -208,7 +266,10 @@ pub fn parse_obj(text: &str, path: &Path) -> Result<ObjData> {
             return Err(GeomError::text(
                 path,
                 line,
-                format!("vertex index {} out of range (file has {nv} vertices)", mv as u64 + 1),
+                format!(
+                    "vertex index {} out of range (file has {nv} vertices)",
+                    mv as u64 + 1
+                ),
             ));
         }
         if let Some(mt) = mt {
@@ -225,7 +286,10 @@ pub fn parse_obj(text: &str, path: &Path) -> Result<ObjData> {
         }
     }
     if nv > u32::MAX as usize {
-        return Err(GeomError::format(path, format!("{nv} vertices do not fit u32 indices")));
+        return Err(GeomError::format(
+            path,
+            format!("{nv} vertices do not fit u32 indices"),
+        ));
     }
     out.face_texcoords = (all_textured && !out.mesh.faces.is_empty()).then_some(tex_faces);
     Ok(out)
@@ -236,7 +300,10 @@ pub fn parse_obj(text: &str, path: &Path) -> Result<ObjData> {
 pub fn write_obj(path: impl AsRef<Path>, mesh: &TriMesh) -> Result<()> {
     write_obj_data(
         path,
-        &ObjData { mesh: mesh.clone(), ..Default::default() },
+        &ObjData {
+            mesh: mesh.clone(),
+            ..Default::default()
+        },
     )
 }
 
@@ -269,7 +336,12 @@ pub fn write_obj_data(path: impl AsRef<Path>, data: &ObjData) -> Result<()> {
         None => None,
     };
     write_atomic(path, |w: &mut dyn Write| {
-        writeln!(w, "# garnet OBJ: {} vertices, {} faces", mesh.vertices.len(), mesh.faces.len())?;
+        writeln!(
+            w,
+            "# garnet OBJ: {} vertices, {} faces",
+            mesh.vertices.len(),
+            mesh.faces.len()
+        )?;
         for v in &mesh.vertices {
             writeln!(w, "v {} {} {}", v.x, v.y, v.z)?;
         }
@@ -327,13 +399,32 @@ mod tests {
         assert_eq!(d.mesh.vertices.len(), 4);
         assert_eq!(
             d.mesh.faces,
-            vec![[0, 1, 2], [0, 1, 2], [0, 1, 2], [0, 2, 3], [0, 1, 2], [0, 2, 3]]
+            vec![
+                [0, 1, 2],
+                [0, 1, 2],
+                [0, 1, 2],
+                [0, 2, 3],
+                [0, 1, 2],
+                [0, 2, 3]
+            ]
         );
         assert_eq!(d.texcoords.len(), 3);
         assert!(d.face_texcoords.is_none());
         assert_eq!(d.groups.len(), 2);
-        assert_eq!(d.groups[0], ObjGroup { name: "a".into(), faces: 0..3 });
-        assert_eq!(d.groups[1], ObjGroup { name: "b c".into(), faces: 3..6 });
+        assert_eq!(
+            d.groups[0],
+            ObjGroup {
+                name: "a".into(),
+                faces: 0..3
+            }
+        );
+        assert_eq!(
+            d.groups[1],
+            ObjGroup {
+                name: "b c".into(),
+                faces: 3..6
+            }
+        );
     }
 
     #[test]
@@ -349,18 +440,45 @@ mod tests {
             ("v 0 0 0\nv 1 x 0\n", ":2:", "not a number"),
             ("v 0 0 nan\n", ":1:", "not finite"),
             ("v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 1 2\n", ":5:", "at least 3"),
-            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", ":4:", "out of range"),
-            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n", ":4:", "out of range"),
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n",
+                ":4:",
+                "out of range",
+            ),
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n",
+                ":4:",
+                "out of range",
+            ),
             ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", ":4:", "index 0"),
-            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3x\n", ":4:", "not an integer"),
-            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/9 2/9 3/9\n", ":4:", "texcoord"),
-            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 /3\n", ":4:", "no position"),
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3x\n",
+                ":4:",
+                "not an integer",
+            ),
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/9 2/9 3/9\n",
+                ":4:",
+                "texcoord",
+            ),
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 /3\n",
+                ":4:",
+                "no position",
+            ),
             ("v 0 0 0\nbogus 1 2\n", ":2:", "unknown statement"),
-            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n", ":4:", "integer"),
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99999999999999999999\n",
+                ":4:",
+                "integer",
+            ),
         ];
         for (src, at, what) in cases {
             let e = parse_obj(src, p()).unwrap_err().to_string();
-            assert!(e.starts_with("t.obj") && e.contains(at) && e.contains(what), "{src:?}: {e}");
+            assert!(
+                e.starts_with("t.obj") && e.contains(at) && e.contains(what),
+                "{src:?}: {e}"
+            );
         }
     }
 
@@ -373,11 +491,20 @@ mod tests {
             texcoords: (0..9).map(|i| Vec2::new(i as f32 / 8.0, 0.25)).collect(),
             face_texcoords: None,
             groups: vec![
-                ObjGroup { name: "left".into(), faces: 0..4 },
-                ObjGroup { name: "right".into(), faces: 4..8 },
+                ObjGroup {
+                    name: "left".into(),
+                    faces: 0..4,
+                },
+                ObjGroup {
+                    name: "right".into(),
+                    faces: 4..8,
+                },
             ],
         };
-        let data = ObjData { face_texcoords: Some(data.mesh.faces.clone()), ..data };
+        let data = ObjData {
+            face_texcoords: Some(data.mesh.faces.clone()),
+            ..data
+        };
         write_obj_data(&path, &data).unwrap();
         assert_eq!(read_obj_data(&path).unwrap(), data);
     }

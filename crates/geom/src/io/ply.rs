@@ -94,7 +94,11 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
         line_no += 1;
         let rest = &bytes[pos..];
         let Some(nl) = rest.iter().position(|&b| b == b'\n') else {
-            return Err(GeomError::text(path, line_no, "header ends before end_header"));
+            return Err(GeomError::text(
+                path,
+                line_no,
+                "header ends before end_header",
+            ));
         };
         let raw = &rest[..nl];
         pos += nl + 1;
@@ -124,9 +128,14 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
                 else {
                     return Err(err("expected \"element NAME COUNT\"".into()));
                 };
-                let count: u64 =
-                    count.parse().map_err(|_| err(format!("bad element count {count:?}")))?;
-                elements.push(Element { name: name.to_string(), count, props: Vec::new() });
+                let count: u64 = count
+                    .parse()
+                    .map_err(|_| err(format!("bad element count {count:?}")))?;
+                elements.push(Element {
+                    name: name.to_string(),
+                    count,
+                    props: Vec::new(),
+                });
             }
             Some("property") => {
                 let Some(el) = elements.last_mut() else {
@@ -156,7 +165,12 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
     }
     let format =
         format.ok_or_else(|| GeomError::text(path, line_no, "header has no format line"))?;
-    Ok(Header { format, elements, data_start: pos, lines: line_no })
+    Ok(Header {
+        format,
+        elements,
+        data_start: pos,
+        lines: line_no,
+    })
 }
 
 /// Where the vertex and face data of interest sit in the element list.
@@ -178,7 +192,9 @@ fn layout(h: &Header, path: &Path) -> Result<Layout> {
     let find = |name: &str| -> Result<usize> {
         match v.props.iter().position(|(n, _)| n == name) {
             Some(i) if matches!(v.props[i].1, Prop::Scalar(_)) => Ok(i),
-            _ => Err(herr(format!("vertex element has no scalar property {name:?}"))),
+            _ => Err(herr(format!(
+                "vertex element has no scalar property {name:?}"
+            ))),
         }
     };
     let xyz = [find("x")?, find("y")?, find("z")?];
@@ -197,7 +213,11 @@ fn layout(h: &Header, path: &Path) -> Result<Layout> {
             _ => return Err(herr("vertex_indices must be a list of integers".into())),
         }
     }
-    Ok(Layout { xyz, face_list, num_vertices: v.count })
+    Ok(Layout {
+        xyz,
+        face_list,
+        num_vertices: v.count,
+    })
 }
 
 /// A source of values: ASCII tokens or binary scalars. Errors carry the position.
@@ -271,8 +291,12 @@ impl<'a> Ascii<'a> {
                 return Some(t);
             }
             let (i, l) = self.lines.next()?;
-            self.line = self.first_line + i;
             self.toks = l.split_ascii_whitespace();
+            if !l.trim_ascii().is_empty() {
+                // Blank lines do not move the reported position (EOF is reported at the last
+                // line holding data).
+                self.line = self.first_line + i;
+            }
         }
     }
 }
@@ -283,9 +307,11 @@ impl Source for Ascii<'_> {
             return Err(self.error("unexpected end of file (header counts too large?)".into()));
         };
         let v: f64 = if s.is_float() {
-            t.parse().map_err(|_| self.error(format!("{t:?} is not a number")))?
+            t.parse()
+                .map_err(|_| self.error(format!("{t:?} is not a number")))?
         } else {
-            t.parse::<i64>().map_err(|_| self.error(format!("{t:?} is not an integer")))? as f64
+            t.parse::<i64>()
+                .map_err(|_| self.error(format!("{t:?} is not an integer")))? as f64
         };
         Ok(v)
     }
@@ -310,6 +336,9 @@ fn read_body(h: &Header, lay: &Layout, src: &mut dyn Source, data_len: usize) ->
     for el in &h.elements {
         // Each element takes at least one byte, which bounds what a lying header can reserve.
         let cap = el.count.min(data_len as u64) as usize;
+        if el.props.is_empty() {
+            continue; // takes no bytes whatever its count
+        }
         let is_vertex = el.name == "vertex";
         let is_face = el.name == "face";
         if is_vertex {
@@ -338,7 +367,9 @@ fn read_body(h: &Header, lay: &Layout, src: &mut dyn Source, data_len: usize) ->
                     Prop::List { count, item } => {
                         let n = src.scalar(count)?;
                         if n < 0.0 {
-                            return Err(src.error(format!("{} {ei}: negative list length", el.name)));
+                            return Err(
+                                src.error(format!("{} {ei}: negative list length", el.name))
+                            );
                         }
                         let keep = is_face && lay.face_list == Some(pi);
                         poly.clear();
@@ -401,8 +432,12 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriMesh> {
             read_body(&h, &lay, &mut src, data.len())
         }
         Format::BinaryLe | Format::BinaryBe => {
-            let mut src =
-                Binary { bytes, pos: h.data_start, big: h.format == Format::BinaryBe, path };
+            let mut src = Binary {
+                bytes,
+                pos: h.data_start,
+                big: h.format == Format::BinaryBe,
+                path,
+            };
             read_body(&h, &lay, &mut src, data.len())
         }
     }
@@ -419,7 +454,9 @@ pub fn read_ply(path: impl AsRef<Path>) -> Result<TriMesh> {
 pub fn encode_ply(mesh: &TriMesh) -> Result<Vec<u8>> {
     mesh.validate()?;
     if mesh.vertices.len() > i32::MAX as usize {
-        return Err(GeomError::InvalidMesh("too many vertices for PLY int indices".into()));
+        return Err(GeomError::InvalidMesh(
+            "too many vertices for PLY int indices".into(),
+        ));
     }
     let mut out = Vec::with_capacity(200 + mesh.vertices.len() * 12 + mesh.faces.len() * 13);
     write!(
@@ -478,13 +515,19 @@ mod tests {
         assert!(e.contains("t.ply:20:") && e.contains("end of file"), "{e}");
         let fewer = ASCII.replace("element face 1", "element face 0");
         let e = parse_ply(fewer.as_bytes(), p()).unwrap_err().to_string();
-        assert!(e.contains("t.ply:19:") && e.contains("after the last"), "{e}");
+        assert!(
+            e.contains("t.ply:19:") && e.contains("after the last"),
+            "{e}"
+        );
         let bad = ASCII.replace("1 1 0 0", "1 z 0 0");
         let e = parse_ply(bad.as_bytes(), p()).unwrap_err().to_string();
         assert!(e.contains("t.ply:17:") && e.contains("\"z\""), "{e}");
-        let e = parse_ply(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n", p())
-            .unwrap_err()
-            .to_string();
+        let e = parse_ply(
+            b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n",
+            p(),
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("\"y\""), "{e}");
         let e = parse_ply(b"plx\n", p()).unwrap_err().to_string();
         assert!(e.contains("t.ply:1:"), "{e}");
@@ -499,7 +542,10 @@ mod tests {
         assert_eq!(parse_ply(&bytes, p()).unwrap(), m);
         let cut = &bytes[..bytes.len() - 5];
         let e = parse_ply(cut, p()).unwrap_err().to_string();
-        assert!(e.contains("t.ply: byte") && e.contains("end of data"), "{e}");
+        assert!(
+            e.contains("t.ply: byte") && e.contains("end of data"),
+            "{e}"
+        );
         let mut extra = bytes.clone();
         extra.push(0);
         assert!(parse_ply(&extra, p()).is_err());

@@ -1,0 +1,110 @@
+//! Integration tests of the `garnet` commands on small inputs.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn garnet(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_garnet")).args(args).output().expect("garnet runs")
+}
+
+fn ok(args: &[&str]) -> String {
+    let out = garnet(args);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "garnet {args:?} failed:\n{stderr}");
+    String::from_utf8_lossy(&out.stdout).into_owned() + &stderr
+}
+
+fn fails(args: &[&str]) -> String {
+    let out = garnet(args);
+    assert!(!out.status.success(), "garnet {args:?} should fail");
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    stderr
+}
+
+fn mocap() -> Option<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/mocap/cmu");
+    dir.is_dir().then_some(dir)
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn assets_path_reports_the_body_file() {
+    let out = ok(&["assets", "path"]);
+    assert!(out.contains("body-v1.safetensors") && out.contains("31 bones"), "{out}");
+}
+
+#[test]
+fn body_writes_mesh_and_picture() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("t.obj");
+    let png = dir.path().join("t.png");
+    ok(&["body", "--tpose", "--gender", "1", "--out", s(&obj), "--png", s(&png)]);
+    let mesh = geom::io::read_mesh(&obj).unwrap();
+    assert_eq!(mesh.vertices.len(), 13380);
+    let image = render::Image::from_png(&png).unwrap();
+    assert!(image.width >= 400 && image.count_not(image.pixel(0, 0)) > 10_000);
+    for ext in ["ply", "glb"] {
+        let p = dir.path().join(format!("r.{ext}"));
+        ok(&["body", "--random-shape", "4", "--pose-procedural", "2", "--pose-kind", "dance", "--out", s(&p)]);
+        assert_eq!(geom::io::read_mesh(&p).unwrap().faces.len(), 26756);
+    }
+}
+
+#[test]
+fn body_refuses_bad_parameters_and_files() {
+    let err = fails(&["body", "--weight", "1.5"]);
+    assert!(err.contains("weight"), "{err}");
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.bvh");
+    std::fs::write(&bad, "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0\n").unwrap();
+    let err = fails(&["body", "--pose-bvh", s(&bad), "--out", s(&dir.path().join("x.obj"))]);
+    assert!(err.contains("bad.bvh"), "{err}");
+    let err = fails(&["body", "--pose-amc", s(&dir.path().join("missing_01.amc"))]);
+    assert!(err.contains("missing_01.amc"), "{err}");
+    assert!(!dir.path().join("x.obj").exists(), "nothing written on error");
+}
+
+#[test]
+fn pose_convert_then_body_from_bvh_and_amc() {
+    let Some(mocap) = mocap() else {
+        eprintln!("skipped: ../shared/mocap not present");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let bvh = dir.path().join("walk.bvh");
+    let (asf, amc) = (mocap.join("02/02.asf"), mocap.join("02/02_01.amc"));
+    ok(&["pose", "convert", "--asf", s(&asf), "--amc", s(&amc), "--out", s(&bvh)]);
+    let from_bvh = dir.path().join("b.obj");
+    let from_amc = dir.path().join("a.obj");
+    ok(&["body", "--pose-bvh", s(&bvh), "--frame", "100", "--out", s(&from_bvh)]);
+    ok(&["body", "--pose-amc", s(&amc), "--frame", "100", "--out", s(&from_amc)]);
+    // The BVH written from the clip poses the body as the clip itself does.
+    let (a, b) = (geom::io::read_mesh(&from_amc).unwrap(), geom::io::read_mesh(&from_bvh).unwrap());
+    let worst = a.vertices.iter().zip(&b.vertices).map(|(p, q)| (*p - *q).length()).fold(0.0, f32::max);
+    assert!(worst < 2e-3, "AMC and BVH poses differ by {worst} m");
+    let err = fails(&["body", "--pose-amc", s(&amc), "--frame", "999999"]);
+    assert!(err.contains("frame"), "{err}");
+}
+
+#[test]
+fn body_sheet_renders_five_shapes_in_five_poses() {
+    let Some(mocap) = mocap() else {
+        eprintln!("skipped: ../shared/mocap not present");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("sheet.png");
+    ok(&["body", "--sheet", s(&png), "--mocap", s(&mocap)]);
+    let image = render::Image::from_png(&png).unwrap();
+    assert!(image.width > 1000 && image.height > 1000);
+}
+
+#[test]
+fn bench_body_reports_ratios() {
+    let out = ok(&["bench", "body", "--repeat", "3"]);
+    assert!(out.contains("pose DQS, 1 core") && out.contains("ratio"), "{out}");
+}
