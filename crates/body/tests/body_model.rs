@@ -118,3 +118,64 @@ fn random_shapes_are_realistic_adults_and_reproducible() {
     let spread = statures.iter().cloned().fold(0.0, f32::max) - statures.iter().cloned().fold(9.0, f32::min);
     assert!(spread > 0.08, "shapes vary: spread {spread}");
 }
+
+#[test]
+fn cmu_walk_frames_stand_upright_with_feet_on_the_floor_and_arms_at_the_sides() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/mocap/cmu/02");
+    if !dir.is_dir() {
+        eprintln!("skipped: ../shared/mocap not present");
+        return;
+    }
+    let clip = body::pose::Clip::from_asf_amc(dir.join("02.asf"), dir.join("02_01.amc")).unwrap();
+    let body = model().shape(&Phenotype { gender: 0.0, age: 0.7, ..Default::default() }).unwrap();
+    let rig = &body.rig;
+    let at = |joints: &[(Vec3, Vec3)], name: &str| joints[rig.index(name).unwrap()].0;
+    for frame in [60, 120, 180, 240, 300] {
+        let pose = clip.pose(frame, rig, &Default::default()).unwrap();
+        let joints = rig.posed_joints(&pose);
+        let (head, hips) = (at(&joints, "Head"), at(&joints, "Hips"));
+        let feet = [at(&joints, "LeftFoot"), at(&joints, "RightFoot")];
+        assert!(head.y > hips.y + 0.4 && feet.iter().all(|f| f.y < hips.y - 0.6), "frame {frame} upright");
+        let up = (head - hips).normalize();
+        assert!(up.y > 0.9, "frame {frame}: trunk leans {up}");
+        let mesh = body.posed(&pose, Skinning::Dqs).unwrap();
+        let floor = mesh.vertices.iter().map(|p| p.y).fold(f32::INFINITY, f32::min);
+        assert!(floor.abs() < 0.05, "frame {frame}: lowest point at {floor} m");
+        // Each foot (ankle or toes: heels lift at toe-off) near the floor.
+        for side in ["Left", "Right"] {
+            let toe = joints[rig.index(&format!("{side}ToeBase")).unwrap()];
+            let low = at(&joints, &format!("{side}Foot")).y.min(toe.0.y).min(toe.1.y);
+            assert!(low < 0.15, "frame {frame}: {side} foot {low} m above the floor");
+        }
+        for (hand, shoulder) in [("LeftHand", "LeftArm"), ("RightHand", "RightArm")] {
+            let (h, s) = (at(&joints, hand), at(&joints, shoulder));
+            assert!(h.y < s.y - 0.35, "frame {frame}: {hand} not below the shoulder");
+            let off = (h - hips).with_y(0.0).length();
+            assert!(off < 0.4, "frame {frame}: {hand} {off} m away from the side, hips {hips}, hand {h}");
+        }
+    }
+}
+
+#[test]
+fn self_contact_flags_an_arm_through_the_torso_but_not_the_rest_pose() {
+    use body::self_contact::SelfContact;
+    let body = model().shape(&Phenotype { weight: 0.9, ..Default::default() }).unwrap();
+    let contact = SelfContact::new(&body);
+    assert_eq!(contact.count_intersections(&body.mesh), 0, "rest pose");
+    let rig = &body.rig;
+    let arm = rig.index("LeftArm").unwrap();
+    let (head, tail) = (rig.bones[arm].head, rig.bones[arm].tail);
+    // Swing the left arm (and everything below it) across the chest.
+    let swing = Quat::from_rotation_arc((tail - head).normalize(), Vec3::new(-1.0, -0.1, 0.05).normalize());
+    let mut world = vec![Quat::IDENTITY; rig.len()];
+    let mut below = vec![false; rig.len()];
+    for (b, bone) in rig.bones.iter().enumerate() {
+        below[b] = b == arm || bone.parent.is_some_and(|p| below[p]);
+        if below[b] {
+            world[b] = swing;
+        }
+    }
+    let pose = Pose::from_world_rotations(rig, &world, Vec3::ZERO);
+    let posed = body.posed(&pose, Skinning::Dqs).unwrap();
+    assert!(contact.count_intersections(&posed) > 20);
+}

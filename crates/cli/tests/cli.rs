@@ -108,3 +108,23 @@ fn bench_body_reports_ratios() {
     let out = ok(&["bench", "body", "--repeat", "3"]);
     assert!(out.contains("pose DQS, 1 core") && out.contains("ratio"), "{out}");
 }
+
+#[test]
+fn missing_pip_or_bad_assets_folder_give_clear_errors() {
+    let home = tempfile::tempdir().unwrap();
+    let run = |envs: &[(&str, &str)]| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_garnet"));
+        cmd.args(["assets", "fetch"]).env("GARNET_HOME", home.path()).env_remove("GARNET_ASSETS");
+        for (k, v) in envs {
+            cmd.env(k, v);
+        }
+        let out = cmd.output().unwrap();
+        assert!(!out.status.success());
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let err = run(&[("PATH", "")]);
+    assert!(err.contains("no python3, pip3 or pip"), "{err}");
+    let err = run(&[("GARNET_ASSETS", "/nonexistent/mpfb2")]);
+    assert!(err.contains("/nonexistent/mpfb2") && err.contains("GARNET_ASSETS"), "{err}");
+    assert!(!home.path().join("body-v1.safetensors").exists());
+}

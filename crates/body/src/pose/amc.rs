@@ -31,8 +31,12 @@ impl Amc {
     pub fn parse(text: &str, path: &Path, asf: &Asf) -> Result<Amc, PoseError> {
         let (offsets, stride) = asf.value_layout();
         let root_len = asf.root.order.len();
-        let names: HashMap<&str, usize> =
-            asf.bones.iter().enumerate().map(|(i, b)| (b.name.as_str(), i)).collect();
+        let names: HashMap<&str, usize> = asf
+            .bones
+            .iter()
+            .enumerate()
+            .map(|(i, b)| (b.name.as_str(), i))
+            .collect();
         let deg = std::f64::consts::PI / 180.0;
         let mut angle_scale = if asf.units.degrees { deg } else { 1.0 };
         let mut fully_specified = false;
@@ -85,14 +89,18 @@ impl Amc {
             let first = toks.next().unwrap_or("");
             if first.bytes().all(|c| c.is_ascii_digit()) {
                 if toks.next().is_some() {
-                    return Err(PoseError::parse(path, ln, "frame number followed by other values"));
+                    return Err(PoseError::parse(
+                        path,
+                        ln,
+                        "frame number followed by other values",
+                    ));
                 }
                 if let Some(&n) = frame_numbers.last() {
                     check_frame(&seen, frame_line, false, fully_specified, n)?;
                 }
-                let n: i64 = first
-                    .parse()
-                    .map_err(|_| PoseError::parse(path, ln, format!("bad frame number '{first}'")))?;
+                let n: i64 = first.parse().map_err(|_| {
+                    PoseError::parse(path, ln, format!("bad frame number '{first}'"))
+                })?;
                 frame_numbers.push(n);
                 values.resize(values.len() + stride, 0.0);
                 seen.iter_mut().for_each(|s| *s = false);
@@ -100,18 +108,30 @@ impl Amc {
                 continue;
             }
             if frame_numbers.is_empty() {
-                return Err(PoseError::parse(path, ln, format!("values for '{first}' before the first frame number")));
+                return Err(PoseError::parse(
+                    path,
+                    ln,
+                    format!("values for '{first}' before the first frame number"),
+                ));
             }
             let (slot, start, dofs): (usize, usize, &[Dof]) = if first == "root" {
                 (0, 0, &asf.root.order)
             } else {
                 let b = *names.get(first).ok_or_else(|| {
-                    PoseError::parse(path, ln, format!("unknown bone '{first}' (not in {})", asf.path.display()))
+                    PoseError::parse(
+                        path,
+                        ln,
+                        format!("unknown bone '{first}' (not in {})", asf.path.display()),
+                    )
                 })?;
                 (b + 1, offsets[b], &asf.bones[b].dofs)
             };
             if seen[slot] {
-                return Err(PoseError::parse(path, ln, format!("'{first}' given twice in one frame")));
+                return Err(PoseError::parse(
+                    path,
+                    ln,
+                    format!("'{first}' given twice in one frame"),
+                ));
             }
             seen[slot] = true;
             let row = values.len() - stride + start;
@@ -122,7 +142,11 @@ impl Amc {
                     continue;
                 }
                 let v = parse_num(tok, path, ln, first)?;
-                let scale = if dofs[k].rotation_axis().is_some() { angle_scale } else { 1.0 };
+                let scale = if dofs[k].rotation_axis().is_some() {
+                    angle_scale
+                } else {
+                    1.0
+                };
                 values[row + k] = v * scale;
             }
             if count != dofs.len() {
@@ -135,7 +159,13 @@ impl Amc {
         }
         match frame_numbers.last() {
             Some(&n) => check_frame(&seen, last_line, true, fully_specified, n)?,
-            None => return Err(PoseError::parse(path, last_line.max(1), "no frames (empty or truncated file?)")),
+            None => {
+                return Err(PoseError::parse(
+                    path,
+                    last_line.max(1),
+                    "no frames (empty or truncated file?)",
+                ))
+            }
         }
         Ok(Amc {
             path: path.to_path_buf(),

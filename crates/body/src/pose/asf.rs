@@ -253,7 +253,10 @@ impl<'a> Parser<'a, '_> {
                 _ => {
                     return Err(self.err(
                         *ln,
-                        format!("expected a section keyword such as ':root', found '{}'", toks[0]),
+                        format!(
+                            "expected a section keyword such as ':root', found '{}'",
+                            toks[0]
+                        ),
                     ))
                 }
             }
@@ -273,7 +276,10 @@ impl<'a> Parser<'a, '_> {
     fn units(&self, lines: &Lines, units: &mut AsfUnits) -> Result<(), PoseError> {
         for (ln, toks) in lines {
             if toks.len() != 2 {
-                return Err(self.err(*ln, format!("units: expected 'key value', found {} tokens", toks.len())));
+                return Err(self.err(
+                    *ln,
+                    format!("units: expected 'key value', found {} tokens", toks.len()),
+                ));
             }
             match toks[0].to_ascii_lowercase().as_str() {
                 "mass" => units.mass = parse_num(toks[1], self.path, *ln, "units mass")?,
@@ -312,7 +318,12 @@ impl<'a> Parser<'a, '_> {
                         .iter()
                         .map(|t| Dof::parse(t).filter(|d| *d != Dof::L))
                         .collect::<Option<Vec<_>>>()
-                        .ok_or_else(|| self.err(*ln, format!("root order: unknown channel in '{}'", rest.join(" "))))?;
+                        .ok_or_else(|| {
+                            self.err(
+                                *ln,
+                                format!("root order: unknown channel in '{}'", rest.join(" ")),
+                            )
+                        })?;
                 }
                 "axis" => {
                     root.axis = rest
@@ -321,9 +332,12 @@ impl<'a> Parser<'a, '_> {
                         .filter(|_| rest.len() == 1)
                         .ok_or_else(|| self.err(*ln, "root axis: expected an order such as XYZ"))?;
                 }
-                "position" => root.position = parse_array::<3>(rest, self.path, *ln, "root position")?.into(),
+                "position" => {
+                    root.position = parse_array::<3>(rest, self.path, *ln, "root position")?.into()
+                }
                 "orientation" => {
-                    root.orientation = parse_array::<3>(rest, self.path, *ln, "root orientation")?.into()
+                    root.orientation =
+                        parse_array::<3>(rest, self.path, *ln, "root orientation")?.into()
                 }
                 _ => {}
             }
@@ -341,7 +355,10 @@ impl<'a> Parser<'a, '_> {
                 break;
             }
             if !toks[0].eq_ignore_ascii_case("begin") {
-                return Err(self.err(*ln, format!("bonedata: expected 'begin', found '{}'", toks[0])));
+                return Err(self.err(
+                    *ln,
+                    format!("bonedata: expected 'begin', found '{}'", toks[0]),
+                ));
             }
             let (bone, next) = self.bone(*ln, i + 1)?;
             bones.push(bone);
@@ -367,7 +384,9 @@ impl<'a> Parser<'a, '_> {
             let Some((ln, toks)) = self.lines.get(i) else {
                 return Err(self.err(
                     self.last_line,
-                    format!("file ends inside the bone block begun at line {begin} (truncated file?)"),
+                    format!(
+                        "file ends inside the bone block begun at line {begin} (truncated file?)"
+                    ),
                 ));
             };
             let ln = *ln;
@@ -375,9 +394,17 @@ impl<'a> Parser<'a, '_> {
             i += 1;
             match toks[0].to_ascii_lowercase().as_str() {
                 "end" => break,
-                "begin" => return Err(self.err(ln, format!("'begin' inside the bone block begun at line {begin}"))),
+                "begin" => {
+                    return Err(self.err(
+                        ln,
+                        format!("'begin' inside the bone block begun at line {begin}"),
+                    ))
+                }
                 k if k.starts_with(':') => {
-                    return Err(self.err(ln, format!("section {k} inside the bone block begun at line {begin}")))
+                    return Err(self.err(
+                        ln,
+                        format!("section {k} inside the bone block begun at line {begin}"),
+                    ))
                 }
                 "id" => {
                     let v = parse_array::<1>(rest, self.path, ln, "id")?[0];
@@ -389,7 +416,10 @@ impl<'a> Parser<'a, '_> {
                     }
                     bone.name = Some(rest[0].to_string());
                 }
-                "direction" => bone.direction = Some(parse_array::<3>(rest, self.path, ln, "direction")?.into()),
+                "direction" => {
+                    bone.direction =
+                        Some(parse_array::<3>(rest, self.path, ln, "direction")?.into())
+                }
                 "length" => {
                     let v = parse_array::<1>(rest, self.path, ln, "length")?[0];
                     if v < 0.0 {
@@ -399,16 +429,27 @@ impl<'a> Parser<'a, '_> {
                 }
                 "axis" => {
                     if rest.len() != 4 {
-                        return Err(self.err(ln, format!("axis: expected 3 angles and an order, found {} values", rest.len())));
+                        return Err(self.err(
+                            ln,
+                            format!(
+                                "axis: expected 3 angles and an order, found {} values",
+                                rest.len()
+                            ),
+                        ));
                     }
                     bone.axis = parse_array::<3>(&rest[..3], self.path, ln, "axis")?.into();
-                    bone.axis_order = Axis::parse_order(rest[3])
-                        .ok_or_else(|| self.err(ln, format!("axis: bad rotation order '{}'", rest[3])))?;
+                    bone.axis_order = Axis::parse_order(rest[3]).ok_or_else(|| {
+                        self.err(ln, format!("axis: bad rotation order '{}'", rest[3]))
+                    })?;
                 }
                 "dof" => {
                     bone.dofs = rest
                         .iter()
-                        .map(|t| Dof::parse(t).ok_or_else(|| self.err(ln, format!("dof: unknown degree of freedom '{t}'"))))
+                        .map(|t| {
+                            Dof::parse(t).ok_or_else(|| {
+                                self.err(ln, format!("dof: unknown degree of freedom '{t}'"))
+                            })
+                        })
                         .collect::<Result<_, _>>()?;
                 }
                 "limits" => {
@@ -445,7 +486,11 @@ impl<'a> Parser<'a, '_> {
 
     /// Parses `:hierarchy`'s `begin ... end`; returns its lines and the next index.
     #[allow(clippy::type_complexity)]
-    fn hierarchy(&self, header: usize, mut i: usize) -> Result<(Vec<(usize, Vec<&'a str>)>, usize), PoseError> {
+    fn hierarchy(
+        &self,
+        header: usize,
+        mut i: usize,
+    ) -> Result<(Vec<(usize, Vec<&'a str>)>, usize), PoseError> {
         let mut out = Vec::new();
         let mut begun = false;
         loop {
@@ -459,7 +504,10 @@ impl<'a> Parser<'a, '_> {
             let key = toks[0].to_ascii_lowercase();
             if !begun {
                 if key != "begin" {
-                    return Err(self.err(*ln, format!("hierarchy: expected 'begin', found '{}'", toks[0])));
+                    return Err(self.err(
+                        *ln,
+                        format!("hierarchy: expected 'begin', found '{}'", toks[0]),
+                    ));
                 }
                 begun = true;
             } else if key == "end" {
@@ -480,16 +528,26 @@ impl<'a> Parser<'a, '_> {
         raw: Vec<RawBone>,
         hierarchy: Vec<(usize, Vec<&str>)>,
     ) -> Result<Asf, PoseError> {
-        let to_rad = if units.degrees { std::f64::consts::PI / 180.0 } else { 1.0 };
+        let to_rad = if units.degrees {
+            std::f64::consts::PI / 180.0
+        } else {
+            1.0
+        };
         root.orientation *= to_rad;
         let mut bones: Vec<AsfBone> = Vec::with_capacity(raw.len());
         for r in raw {
-            let name = r.name.ok_or_else(|| self.err(r.line, "bone block without 'name'"))?;
+            let name = r
+                .name
+                .ok_or_else(|| self.err(r.line, "bone block without 'name'"))?;
             if name == "root" || bones.iter().any(|b| b.name == name) {
                 return Err(self.err(r.line, format!("bone '{name}' defined twice")));
             }
-            let length = r.length.ok_or_else(|| self.err(r.line, format!("bone '{name}' has no 'length'")))?;
-            let dir = r.direction.ok_or_else(|| self.err(r.line, format!("bone '{name}' has no 'direction'")))?;
+            let length = r
+                .length
+                .ok_or_else(|| self.err(r.line, format!("bone '{name}' has no 'length'")))?;
+            let dir = r
+                .direction
+                .ok_or_else(|| self.err(r.line, format!("bone '{name}' has no 'direction'")))?;
             let direction = if dir.length() > 1e-12 {
                 dir.normalize()
             } else if length == 0.0 {
@@ -513,7 +571,11 @@ impl<'a> Parser<'a, '_> {
                 .chunks(2)
                 .zip(&r.dofs)
                 .map(|(c, d)| {
-                    let s = if d.rotation_axis().is_some() { to_rad } else { 1.0 };
+                    let s = if d.rotation_axis().is_some() {
+                        to_rad
+                    } else {
+                        1.0
+                    };
                     (c[0] * s, c[1] * s)
                 })
                 .collect();
@@ -537,12 +599,21 @@ impl<'a> Parser<'a, '_> {
                 usize::MAX
             } else {
                 find(toks[0]).ok_or_else(|| {
-                    self.err(*ln, format!("hierarchy: bone '{}' was never defined in :bonedata", toks[0]))
+                    self.err(
+                        *ln,
+                        format!(
+                            "hierarchy: bone '{}' was never defined in :bonedata",
+                            toks[0]
+                        ),
+                    )
                 })?
             };
             for c in &toks[1..] {
                 let ci = find(c).ok_or_else(|| {
-                    self.err(*ln, format!("hierarchy: bone '{c}' was never defined in :bonedata"))
+                    self.err(
+                        *ln,
+                        format!("hierarchy: bone '{c}' was never defined in :bonedata"),
+                    )
                 })?;
                 if parent[ci].is_some() {
                     return Err(self.err(*ln, format!("hierarchy: bone '{c}' has two parents")));
@@ -554,13 +625,18 @@ impl<'a> Parser<'a, '_> {
         for (i, p) in parent.iter().enumerate() {
             match p {
                 None => {
-                    return Err(self.err(hier_line, format!("bone '{}' does not appear in :hierarchy", bones[i].name)))
+                    return Err(self.err(
+                        hier_line,
+                        format!("bone '{}' does not appear in :hierarchy", bones[i].name),
+                    ))
                 }
                 Some(p) => bones[i].parent = (*p != usize::MAX).then_some(*p),
             }
         }
         // Parents-first order, breadth first from the root's children.
-        let mut order: Vec<usize> = (0..bones.len()).filter(|&i| bones[i].parent.is_none()).collect();
+        let mut order: Vec<usize> = (0..bones.len())
+            .filter(|&i| bones[i].parent.is_none())
+            .collect();
         let mut k = 0;
         while k < order.len() {
             let p = order[k];
@@ -569,7 +645,13 @@ impl<'a> Parser<'a, '_> {
         }
         if order.len() != bones.len() {
             let lost = (0..bones.len()).find(|i| !order.contains(i)).unwrap_or(0);
-            return Err(self.err(hier_line, format!("hierarchy: bone '{}' is not connected to the root (cycle)", bones[lost].name)));
+            return Err(self.err(
+                hier_line,
+                format!(
+                    "hierarchy: bone '{}' is not connected to the root (cycle)",
+                    bones[lost].name
+                ),
+            ));
         }
         Ok(Asf {
             path: self.path.to_path_buf(),

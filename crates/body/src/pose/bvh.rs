@@ -101,7 +101,9 @@ impl Bvh {
         let motion = lines
             .iter()
             .position(|l| l.split_whitespace().next() == Some("MOTION"))
-            .ok_or_else(|| PoseError::parse(path, last_line, "no MOTION section (truncated file?)"))?;
+            .ok_or_else(|| {
+                PoseError::parse(path, last_line, "no MOTION section (truncated file?)")
+            })?;
         let tokens: Vec<(usize, &str)> = lines[..motion]
             .iter()
             .enumerate()
@@ -119,13 +121,21 @@ impl Bvh {
         h.expect("ROOT")?;
         h.joint(None)?;
         if let Some(&(ln, t)) = tokens.get(h.at) {
-            return Err(PoseError::parse(path, ln, format!("unexpected '{t}' after the root joint (only one ROOT is supported)")));
+            return Err(PoseError::parse(
+                path,
+                ln,
+                format!("unexpected '{t}' after the root joint (only one ROOT is supported)"),
+            ));
         }
         let (joints, channel_count) = (h.joints, h.channels);
         let (frame_time, values) = parse_motion(&lines, motion, path, &joints, channel_count)?;
         let metres_per_unit = match metres_per_unit {
             Some(s) if s.is_finite() && s > 0.0 => s,
-            Some(s) => return Err(PoseError::Invalid(format!("BVH unit {s} m is not positive"))),
+            Some(s) => {
+                return Err(PoseError::Invalid(format!(
+                    "BVH unit {s} m is not positive"
+                )))
+            }
             None => detect_unit(&joints),
         };
         Ok(Bvh {
@@ -218,7 +228,11 @@ impl Bvh {
         self.joints
             .iter()
             .enumerate()
-            .filter_map(|(j, joint)| joint.end_site.map(|e| pos[j] + world[j] * (e * self.metres_per_unit)))
+            .filter_map(|(j, joint)| {
+                joint
+                    .end_site
+                    .map(|e| pos[j] + world[j] * (e * self.metres_per_unit))
+            })
             .collect()
     }
 }
@@ -258,7 +272,11 @@ struct HierarchyParser<'a, 'b> {
 impl<'a> HierarchyParser<'a, '_> {
     fn next(&mut self, what: &str) -> Result<(usize, &'a str), PoseError> {
         let t = self.tokens.get(self.at).copied().ok_or_else(|| {
-            PoseError::parse(self.path, self.end_line, format!("hierarchy ends where {what} was expected"))
+            PoseError::parse(
+                self.path,
+                self.end_line,
+                format!("hierarchy ends where {what} was expected"),
+            )
         })?;
         self.at += 1;
         Ok(t)
@@ -267,7 +285,11 @@ impl<'a> HierarchyParser<'a, '_> {
     fn expect(&mut self, word: &str) -> Result<usize, PoseError> {
         let (ln, t) = self.next(&format!("'{word}'"))?;
         if t != word {
-            return Err(PoseError::parse(self.path, ln, format!("expected '{word}', found '{t}'")));
+            return Err(PoseError::parse(
+                self.path,
+                ln,
+                format!("expected '{word}', found '{t}'"),
+            ));
         }
         Ok(ln)
     }
@@ -301,14 +323,20 @@ impl<'a> HierarchyParser<'a, '_> {
             match t {
                 "CHANNELS" => {
                     if !self.joints[index].channels.is_empty() {
-                        return Err(PoseError::parse(self.path, ln, "second CHANNELS line in one joint"));
+                        return Err(PoseError::parse(
+                            self.path,
+                            ln,
+                            "second CHANNELS line in one joint",
+                        ));
                     }
                     let (_, n) = self.next("a channel count")?;
-                    let n: usize = n
-                        .parse()
-                        .ok()
-                        .filter(|&n| n <= 6)
-                        .ok_or_else(|| PoseError::parse(self.path, ln, format!("CHANNELS: bad channel count '{n}' (0 to 6)")))?;
+                    let n: usize = n.parse().ok().filter(|&n| n <= 6).ok_or_else(|| {
+                        PoseError::parse(
+                            self.path,
+                            ln,
+                            format!("CHANNELS: bad channel count '{n}' (0 to 6)"),
+                        )
+                    })?;
                     for k in 0..n {
                         let (cl, c) = self.next("a channel name")?;
                         let ch = BvhChannel::parse(c).ok_or_else(|| {
@@ -335,7 +363,11 @@ impl<'a> HierarchyParser<'a, '_> {
                     let e = self.offset()?;
                     self.expect("}")?;
                     if self.joints[index].end_site.is_some() {
-                        return Err(PoseError::parse(self.path, ln, "second End Site in one joint"));
+                        return Err(PoseError::parse(
+                            self.path,
+                            ln,
+                            "second End Site in one joint",
+                        ));
                     }
                     self.joints[index].end_site = Some(e);
                 }
@@ -373,15 +405,27 @@ fn parse_motion(
         while i < lines.len() && lines[i].trim().is_empty() {
             i += 1;
         }
-        let line = lines.get(i).ok_or_else(|| PoseError::parse(path, last_line, format!("file ends before '{key}' (truncated file?)")))?;
+        let line = lines.get(i).ok_or_else(|| {
+            PoseError::parse(
+                path,
+                last_line,
+                format!("file ends before '{key}' (truncated file?)"),
+            )
+        })?;
         let rest = line.trim().strip_prefix(key).ok_or_else(|| {
-            PoseError::parse(path, i + 1, format!("expected '{key}', found '{}'", line.trim()))
+            PoseError::parse(
+                path,
+                i + 1,
+                format!("expected '{key}', found '{}'", line.trim()),
+            )
         })?;
         i += 1;
         Ok((i, rest.trim().to_string()))
     };
     let (ln, n) = header("Frames:")?;
-    let frames: usize = n.parse().map_err(|_| PoseError::parse(path, ln, format!("Frames: bad count '{n}'")))?;
+    let frames: usize = n
+        .parse()
+        .map_err(|_| PoseError::parse(path, ln, format!("Frames: bad count '{n}'")))?;
     let (ln, t) = header("Frame Time:")?;
     let frame_time = parse_num(&t, path, ln, "Frame Time")?;
     if frame_time <= 0.0 {
@@ -396,13 +440,21 @@ fn parse_motion(
             continue;
         }
         if read == frames {
-            return Err(PoseError::parse(path, ln, format!("more frames than the {frames} declared")));
+            return Err(PoseError::parse(
+                path,
+                ln,
+                format!("more frames than the {frames} declared"),
+            ));
         }
         let start = values.len();
         for tok in line.split_whitespace() {
             let v = parse_num(tok, path, ln, "frame value")?;
             let c = values.len() - start;
-            values.push(if c < channel_count && is_rotation[c] { v * deg } else { v });
+            values.push(if c < channel_count && is_rotation[c] {
+                v * deg
+            } else {
+                v
+            });
         }
         let found = values.len() - start;
         if found != channel_count {

@@ -40,7 +40,9 @@ fn v3(out: &mut String, v: DVec3) {
 
 /// The BVH text of every frame of `amc` on `asf`.
 pub fn bvh_string(asf: &Asf, amc: &Amc, opts: &BvhWriteOptions) -> Result<String, PoseError> {
-    let unit = opts.metres_per_unit.unwrap_or_else(|| asf.metres_per_unit());
+    let unit = opts
+        .metres_per_unit
+        .unwrap_or_else(|| asf.metres_per_unit());
     if !(unit.is_finite() && unit > 0.0 && opts.frame_time.is_finite() && opts.frame_time > 0.0) {
         return Err(PoseError::Invalid(format!(
             "BVH unit {unit} m and frame time {} s must be positive",
@@ -54,7 +56,8 @@ pub fn bvh_string(asf: &Asf, amc: &Amc, opts: &BvhWriteOptions) -> Result<String
     out.push_str("\n\tCHANNELS 6 Xposition Yposition Zposition Zrotation Yrotation Xrotation\n");
     // Joints in depth-first order: the order their channels appear in a frame row.
     let mut dfs: Vec<usize> = Vec::with_capacity(asf.bones.len());
-    let children = |p: Option<usize>| (0..asf.bones.len()).filter(move |&i| asf.bones[i].parent == p);
+    let children =
+        |p: Option<usize>| (0..asf.bones.len()).filter(move |&i| asf.bones[i].parent == p);
     fn write_joint(
         asf: &Asf,
         i: usize,
@@ -74,7 +77,9 @@ pub fn bvh_string(asf: &Asf, amc: &Amc, opts: &BvhWriteOptions) -> Result<String
         v3(out, offset);
         let _ = writeln!(out, "\n{tabs}\tCHANNELS 3 Zrotation Yrotation Xrotation");
         dfs.push(i);
-        let kids: Vec<usize> = (0..asf.bones.len()).filter(|&c| asf.bones[c].parent == Some(i)).collect();
+        let kids: Vec<usize> = (0..asf.bones.len())
+            .filter(|&c| asf.bones[c].parent == Some(i))
+            .collect();
         if kids.is_empty() {
             let _ = write!(out, "{tabs}\tEnd Site\n{tabs}\t{{\n{tabs}\t\tOFFSET ");
             v3(out, bone.direction * bone.length * scale);
@@ -96,14 +101,22 @@ pub fn bvh_string(asf: &Asf, amc: &Amc, opts: &BvhWriteOptions) -> Result<String
     );
     let deg = |q: DQuat, out: &mut String| {
         let (z, y, x) = to_zyx(q);
-        let _ = write!(out, " {:.6} {:.6} {:.6}", z.to_degrees(), y.to_degrees(), x.to_degrees());
+        let _ = write!(
+            out,
+            " {:.6} {:.6} {:.6}",
+            z.to_degrees(),
+            y.to_degrees(),
+            x.to_degrees()
+        );
     };
     for f in 0..amc.frame_count() {
         let pose = asf.pose_of(amc, f)?;
         v3(&mut out, (pose.root_position - asf.root.position) * scale);
         deg(pose.root_rotation, &mut out);
         for &i in &dfs {
-            let parent = asf.bones[i].parent.map_or(pose.root_rotation, |p| pose.world[p]);
+            let parent = asf.bones[i]
+                .parent
+                .map_or(pose.root_rotation, |p| pose.world[p]);
             deg(parent.inverse() * pose.world[i], &mut out);
         }
         out.push('\n');
@@ -112,7 +125,12 @@ pub fn bvh_string(asf: &Asf, amc: &Amc, opts: &BvhWriteOptions) -> Result<String
 }
 
 /// Writes [`bvh_string`] to `path` (through a temporary file renamed into place).
-pub fn save_bvh(path: impl AsRef<Path>, asf: &Asf, amc: &Amc, opts: &BvhWriteOptions) -> Result<(), PoseError> {
+pub fn save_bvh(
+    path: impl AsRef<Path>,
+    asf: &Asf,
+    amc: &Amc,
+    opts: &BvhWriteOptions,
+) -> Result<(), PoseError> {
     let path = path.as_ref();
     let text = bvh_string(asf, amc, opts)?;
     let io = |source| PoseError::Io {

@@ -91,10 +91,7 @@ mod tests {
         assert!(a.angle_between(m) < 1e-7 && b.angle_between(m) < 1e-7);
         let (z2, y2, x2) = to_zyx(m);
         assert!(intrinsic(&axes, &[z2, y2, x2]).angle_between(m) < 1e-7);
-        assert_eq!(
-            Axis::parse_order("xZy"),
-            Some([Axis::X, Axis::Z, Axis::Y])
-        );
+        assert_eq!(Axis::parse_order("xZy"), Some([Axis::X, Axis::Z, Axis::Y]));
         assert_eq!(Axis::parse_order("XXY"), None);
         assert_eq!(Axis::parse_order("XYZW"), None);
     }

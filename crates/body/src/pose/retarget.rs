@@ -29,11 +29,17 @@ pub struct RetargetOptions {
 
 /// World rotation deltas `[B]` of every rig bone for one source frame (see the module
 /// documentation).
-pub fn retarget_rotations(rig: &Rig, skeleton: &SourceSkeleton, frame: &SourceFrame) -> Result<Vec<Quat>, PoseError> {
+pub fn retarget_rotations(
+    rig: &Rig,
+    skeleton: &SourceSkeleton,
+    frame: &SourceFrame,
+) -> Result<Vec<Quat>, PoseError> {
     if rig.is_empty() {
         return Err(PoseError::Rig("the rig has no bones".into()));
     }
-    if frame.world.len() != skeleton.names.len() || skeleton.rest_vectors.len() != skeleton.names.len() {
+    if frame.world.len() != skeleton.names.len()
+        || skeleton.rest_vectors.len() != skeleton.names.len()
+    {
         return Err(PoseError::Invalid(format!(
             "source frame has {} rotations for {} bones",
             frame.world.len(),
@@ -46,7 +52,11 @@ pub fn retarget_rotations(rig: &Rig, skeleton: &SourceSkeleton, frame: &SourceFr
         .enumerate()
         .map(|(i, n)| (n.as_str(), i))
         .collect();
-    let root_g = frame.world.get(skeleton.root).copied().unwrap_or(DQuat::IDENTITY);
+    let root_g = frame
+        .world
+        .get(skeleton.root)
+        .copied()
+        .unwrap_or(DQuat::IDENTITY);
     let mut deltas: Vec<Quat> = Vec::with_capacity(rig.len());
     for bone in &rig.bones {
         let source = by_name.get(bone.name.as_str()).copied();
@@ -72,13 +82,20 @@ pub fn retarget_rotations(rig: &Rig, skeleton: &SourceSkeleton, frame: &SourceFr
 /// Hip-to-ankle length of a rig (thigh plus shin, mean of both legs), metres; falls back
 /// to the root's height above the lowest joint.
 pub fn rig_leg_length(rig: &Rig) -> f32 {
-    let len = |n: &str| rig.index(n).map(|i| (rig.bones[i].tail - rig.bones[i].head).length());
+    let len = |n: &str| {
+        rig.index(n)
+            .map(|i| (rig.bones[i].tail - rig.bones[i].head).length())
+    };
     let legs: Vec<f32> = [("LeftUpLeg", "LeftLeg"), ("RightUpLeg", "RightLeg")]
         .iter()
         .filter_map(|(a, b)| Some(len(a)? + len(b)?))
         .collect();
     if legs.is_empty() {
-        let lowest = rig.bones.iter().flat_map(|b| [b.head.y, b.tail.y]).fold(f32::INFINITY, f32::min);
+        let lowest = rig
+            .bones
+            .iter()
+            .flat_map(|b| [b.head.y, b.tail.y])
+            .fold(f32::INFINITY, f32::min);
         rig.bones.first().map_or(0.0, |b| b.head.y - lowest)
     } else {
         legs.iter().sum::<f32>() / legs.len() as f32
@@ -89,7 +106,12 @@ pub fn rig_leg_length(rig: &Rig) -> f32 {
 /// ratio of leg lengths, its height taken relative to the source's standing rest root
 /// height (so a standing source keeps the rig's feet on its floor), horizontal motion
 /// kept only if asked.
-pub fn retarget_translation(rig: &Rig, skeleton: &SourceSkeleton, frame: &SourceFrame, opts: &RetargetOptions) -> Vec3 {
+pub fn retarget_translation(
+    rig: &Rig,
+    skeleton: &SourceSkeleton,
+    frame: &SourceFrame,
+    opts: &RetargetOptions,
+) -> Vec3 {
     let scale = if skeleton.leg_length > 1e-9 {
         rig_leg_length(rig) as f64 / skeleton.leg_length
     } else {
@@ -106,7 +128,12 @@ pub fn retarget_translation(rig: &Rig, skeleton: &SourceSkeleton, frame: &Source
 }
 
 /// Retargets one source frame onto `rig`.
-pub fn retarget(rig: &Rig, skeleton: &SourceSkeleton, frame: &SourceFrame, opts: &RetargetOptions) -> Result<Pose, PoseError> {
+pub fn retarget(
+    rig: &Rig,
+    skeleton: &SourceSkeleton,
+    frame: &SourceFrame,
+    opts: &RetargetOptions,
+) -> Result<Pose, PoseError> {
     let deltas = retarget_rotations(rig, skeleton, frame)?;
     let t = retarget_translation(rig, skeleton, frame, opts);
     Ok(Pose::from_world_rotations(rig, &deltas, t))
@@ -139,7 +166,10 @@ pub struct Clip {
 
 impl Clip {
     /// A clip from an ASF skeleton and an AMC motion file, at 120 frames per second.
-    pub fn from_asf_amc(asf_path: impl AsRef<Path>, amc_path: impl AsRef<Path>) -> Result<Clip, PoseError> {
+    pub fn from_asf_amc(
+        asf_path: impl AsRef<Path>,
+        amc_path: impl AsRef<Path>,
+    ) -> Result<Clip, PoseError> {
         let asf = Asf::read(asf_path)?;
         let amc = Amc::read(amc_path, &asf)?;
         Ok(Clip {
@@ -153,7 +183,10 @@ impl Clip {
     }
 
     /// A clip from a BVH file; `metres_per_unit` as in [`Bvh::read`].
-    pub fn from_bvh(path: impl AsRef<Path>, metres_per_unit: Option<f64>) -> Result<Clip, PoseError> {
+    pub fn from_bvh(
+        path: impl AsRef<Path>,
+        metres_per_unit: Option<f64>,
+    ) -> Result<Clip, PoseError> {
         let bvh = Bvh::read(path, metres_per_unit)?;
         Ok(Clip {
             skeleton: SourceSkeleton::from_bvh(&bvh),
@@ -178,7 +211,9 @@ impl Clip {
     /// Frame `frame` (0-based) as world rotations of the source skeleton.
     pub fn source_frame(&self, frame: usize) -> Result<SourceFrame, PoseError> {
         match &self.data {
-            ClipData::AsfAmc { asf, amc } => Ok(SourceFrame::from_asf(asf, &asf.pose_of(amc, frame)?)),
+            ClipData::AsfAmc { asf, amc } => {
+                Ok(SourceFrame::from_asf(asf, &asf.pose_of(amc, frame)?))
+            }
             ClipData::Bvh(b) => {
                 let (world, pos) = b.pose(Some(frame))?;
                 Ok(SourceFrame {

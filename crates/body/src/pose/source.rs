@@ -34,7 +34,12 @@ pub struct SourceFrame {
 }
 
 impl SourceSkeleton {
-    fn new(names: Vec<String>, rest_vectors: Vec<DVec3>, root: usize, rest_root_height: f64) -> Self {
+    fn new(
+        names: Vec<String>,
+        rest_vectors: Vec<DVec3>,
+        root: usize,
+        rest_root_height: f64,
+    ) -> Self {
         let len = |n: &str| {
             names
                 .iter()
@@ -71,7 +76,10 @@ impl SourceSkeleton {
             vectors.push(b.direction * b.length * s);
         }
         let (root, ends) = asf.joint_positions(&asf.rest_pose());
-        let lowest = ends.iter().flat_map(|(h, t)| [h.y, t.y]).fold(root.y, f64::min);
+        let lowest = ends
+            .iter()
+            .flat_map(|(h, t)| [h.y, t.y])
+            .fold(root.y, f64::min);
         Self::new(names, vectors, 0, root.y - lowest)
     }
 

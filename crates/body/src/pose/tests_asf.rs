@@ -79,16 +79,25 @@ fn kinematics_follow_the_asf_convention() {
 #[test]
 fn out_of_range_frame_is_an_error() {
     let (asf, amc) = mini();
-    assert!(matches!(asf.pose_of(&amc, 2), Err(PoseError::FrameOutOfRange { frame: 2, count: 2 })));
+    assert!(matches!(
+        asf.pose_of(&amc, 2),
+        Err(PoseError::FrameOutOfRange { frame: 2, count: 2 })
+    ));
 }
 
 #[test]
 fn asf_errors_name_the_line() {
     let p = Path::new("x.asf");
-    let bad_len = MINI_ASF.replace("length 7\n     axis 0 0 20  XYZ", "length seven\n     axis 0 0 20  XYZ");
+    let bad_len = MINI_ASF.replace(
+        "length 7\n     axis 0 0 20  XYZ",
+        "length seven\n     axis 0 0 20  XYZ",
+    );
     let (line, msg) = line_of(Asf::parse(&bad_len, p).unwrap_err());
     assert_eq!(line, 27);
-    assert!(msg.contains("non-numeric") && msg.contains("seven"), "{msg}");
+    assert!(
+        msg.contains("non-numeric") && msg.contains("seven"),
+        "{msg}"
+    );
     let truncated: String = MINI_ASF.lines().take(30).collect::<Vec<_>>().join("\n");
     let (line, msg) = line_of(Asf::parse(&truncated, p).unwrap_err());
     assert_eq!(line, 30);
@@ -96,15 +105,26 @@ fn asf_errors_name_the_line() {
     let undefined = MINI_ASF.replace("lfemur ltibia", "lfemur ltibia rtibia");
     let (line, msg) = line_of(Asf::parse(&undefined, p).unwrap_err());
     assert_eq!(line, 55);
-    assert!(msg.contains("rtibia") && msg.contains("never defined"), "{msg}");
+    assert!(
+        msg.contains("rtibia") && msg.contains("never defined"),
+        "{msg}"
+    );
     let no_hier = MINI_ASF.split(":hierarchy").next().unwrap();
-    assert!(line_of(Asf::parse(no_hier, p).unwrap_err()).1.contains(":hierarchy"));
+    assert!(line_of(Asf::parse(no_hier, p).unwrap_err())
+        .1
+        .contains(":hierarchy"));
     let nan = MINI_ASF.replace("direction 0 1 0", "direction 0 nan 0");
-    assert!(line_of(Asf::parse(&nan, p).unwrap_err()).1.contains("non-finite"));
+    assert!(line_of(Asf::parse(&nan, p).unwrap_err())
+        .1
+        .contains("non-finite"));
     let limits = MINI_ASF.replace("           (-60.0 70.0)\n", "");
-    assert!(line_of(Asf::parse(&limits, p).unwrap_err()).1.contains("limit values"));
+    assert!(line_of(Asf::parse(&limits, p).unwrap_err())
+        .1
+        .contains("limit values"));
     let orphan = MINI_ASF.replace("    lfemur ltibia\n", "");
-    assert!(line_of(Asf::parse(&orphan, p).unwrap_err()).1.contains("ltibia"));
+    assert!(line_of(Asf::parse(&orphan, p).unwrap_err())
+        .1
+        .contains("ltibia"));
     assert!(Asf::parse("", p).is_err());
     assert!(Asf::parse("garbage here", p).is_err());
 }
@@ -114,14 +134,46 @@ fn amc_errors_name_the_line() {
     let (asf, _) = mini();
     let p = Path::new("x.amc");
     let cases = [
-        (MINI_AMC.replace("ltibia 0\n2", "rtibia 0\n2"), 8, "unknown bone 'rtibia'"),
-        (MINI_AMC.replace("lfemur -90 0 0", "lfemur -90 0"), 11, "has 2 values, expected 3"),
-        (MINI_AMC.replace("lfemur -90 0 0", "lfemur -90 x 0"), 11, "non-numeric"),
-        (MINI_AMC.replace("lfemur -90 0 0", "lfemur -90 NaN 0"), 11, "non-finite"),
-        (MINI_AMC.replace("lowerback 10 0 0\n", ""), 12, "ends in the middle of frame 2"),
-        (MINI_AMC.replace("lowerback 0 0 0\n", ""), 4, "frame 1 has no values for lowerback"),
-        (MINI_AMC.replace("ltibia 0\n2", "ltibia 0\nltibia 0\n2"), 9, "given twice"),
-        (MINI_AMC.replace(":DEGREES\n1\n", ":DEGREES\n"), 4, "before the first frame"),
+        (
+            MINI_AMC.replace("ltibia 0\n2", "rtibia 0\n2"),
+            8,
+            "unknown bone 'rtibia'",
+        ),
+        (
+            MINI_AMC.replace("lfemur -90 0 0", "lfemur -90 0"),
+            11,
+            "has 2 values, expected 3",
+        ),
+        (
+            MINI_AMC.replace("lfemur -90 0 0", "lfemur -90 x 0"),
+            11,
+            "non-numeric",
+        ),
+        (
+            MINI_AMC.replace("lfemur -90 0 0", "lfemur -90 NaN 0"),
+            11,
+            "non-finite",
+        ),
+        (
+            MINI_AMC.replace("lowerback 10 0 0\n", ""),
+            12,
+            "ends in the middle of frame 2",
+        ),
+        (
+            MINI_AMC.replace("lowerback 0 0 0\n", ""),
+            4,
+            "frame 1 has no values for lowerback",
+        ),
+        (
+            MINI_AMC.replace("ltibia 0\n2", "ltibia 0\nltibia 0\n2"),
+            9,
+            "given twice",
+        ),
+        (
+            MINI_AMC.replace(":DEGREES\n1\n", ":DEGREES\n"),
+            4,
+            "before the first frame",
+        ),
         (":FULLY-SPECIFIED\n".to_string(), 1, "no frames"),
     ];
     for (text, want_line, want) in cases {

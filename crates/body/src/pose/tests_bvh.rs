@@ -54,13 +54,20 @@ fn reads_hierarchy_and_motion() {
     assert!((pos[1] - (pos[0] + root * DVec3::new(0.1, 0.0, 0.0))).length() < 1e-12);
     let ends = bvh.end_sites(&world, &pos);
     assert!((ends[0] - (pos[1] + leg * DVec3::new(0.0, -1.0, 0.0))).length() < 1e-12);
-    assert!(matches!(bvh.pose(Some(2)), Err(PoseError::FrameOutOfRange { .. })));
+    assert!(matches!(
+        bvh.pose(Some(2)),
+        Err(PoseError::FrameOutOfRange { .. })
+    ));
 }
 
 #[test]
 fn detects_the_length_unit() {
     let scaled = |s: f64| TWO_JOINTS.replace("0 -100 0", &format!("0 {} 0", -s));
-    let unit = |t: &str| Bvh::parse(t, Path::new("t.bvh"), None).unwrap().metres_per_unit;
+    let unit = |t: &str| {
+        Bvh::parse(t, Path::new("t.bvh"), None)
+            .unwrap()
+            .metres_per_unit
+    };
     assert_eq!(unit(&scaled(1.6)), 1.0);
     assert_eq!(unit(&scaled(160.0)), 0.01);
     assert_eq!(unit(&scaled(1600.0)), 0.001);
@@ -71,17 +78,61 @@ fn detects_the_length_unit() {
 #[test]
 fn errors_name_the_line() {
     let cases = [
-        (TWO_JOINTS.replace("1 90 2 90 0 0 30 40 50\n", ""), 19, "ends after 1 of 2 frames"),
-        (TWO_JOINTS.replace("0 0 30 40 50", "0 0 30 40"), 20, "8 values, expected 9"),
-        (TWO_JOINTS.replace("0 0 30 40 50", "0 0 30 40 50 60"), 20, "10 values, expected 9"),
-        (TWO_JOINTS.replace("0 0 30 40 50", "0 0 30 nan 50"), 20, "non-finite"),
-        (TWO_JOINTS.replace("Xrotation Yrotation Zrotation", "Xrotation Yrotation"), 9, "wrong channel count"),
-        (TWO_JOINTS.replace("CHANNELS 3", "CHANNELS 7"), 9, "bad channel count"),
-        (TWO_JOINTS.replace("OFFSET 10 0 0", "OFFSET 10 zero 0"), 8, "non-numeric"),
-        (TWO_JOINTS.replace("Frames: 2", "Frames: 1"), 20, "more frames than the 1 declared"),
-        (TWO_JOINTS.replace("Frames: 2", "Frame: 2"), 17, "expected 'Frames:'"),
-        (TWO_JOINTS.split("MOTION").next().unwrap().to_string(), 15, "no MOTION"),
-        (TWO_JOINTS.replace("  }\n}\n", "  }\n"), 15, "hierarchy ends"),
+        (
+            TWO_JOINTS.replace("1 90 2 90 0 0 30 40 50\n", ""),
+            19,
+            "ends after 1 of 2 frames",
+        ),
+        (
+            TWO_JOINTS.replace("0 0 30 40 50", "0 0 30 40"),
+            20,
+            "8 values, expected 9",
+        ),
+        (
+            TWO_JOINTS.replace("0 0 30 40 50", "0 0 30 40 50 60"),
+            20,
+            "10 values, expected 9",
+        ),
+        (
+            TWO_JOINTS.replace("0 0 30 40 50", "0 0 30 nan 50"),
+            20,
+            "non-finite",
+        ),
+        (
+            TWO_JOINTS.replace("Xrotation Yrotation Zrotation", "Xrotation Yrotation"),
+            9,
+            "wrong channel count",
+        ),
+        (
+            TWO_JOINTS.replace("CHANNELS 3", "CHANNELS 7"),
+            9,
+            "bad channel count",
+        ),
+        (
+            TWO_JOINTS.replace("OFFSET 10 0 0", "OFFSET 10 zero 0"),
+            8,
+            "non-numeric",
+        ),
+        (
+            TWO_JOINTS.replace("Frames: 2", "Frames: 1"),
+            20,
+            "more frames than the 1 declared",
+        ),
+        (
+            TWO_JOINTS.replace("Frames: 2", "Frame: 2"),
+            17,
+            "expected 'Frames:'",
+        ),
+        (
+            TWO_JOINTS.split("MOTION").next().unwrap().to_string(),
+            15,
+            "no MOTION",
+        ),
+        (
+            TWO_JOINTS.replace("  }\n}\n", "  }\n"),
+            15,
+            "hierarchy ends",
+        ),
     ];
     for (text, want_line, want) in cases {
         let (line, msg) = parse_err(&text);
@@ -108,7 +159,10 @@ fn written_bvh_reproduces_the_asf_clip() {
             assert!((pos[j] - ends[i].0).length() < 1e-6, "{name} frame {f}");
         }
         let tips = bvh.end_sites(&world, &pos);
-        let leaf_tails = [asf.bone_index("ltibia").unwrap(), asf.bone_index("lowerback").unwrap()];
+        let leaf_tails = [
+            asf.bone_index("ltibia").unwrap(),
+            asf.bone_index("lowerback").unwrap(),
+        ];
         for (t, &i) in tips.iter().zip(&leaf_tails) {
             assert!((*t - ends[i].1).length() < 1e-6);
         }

@@ -24,11 +24,19 @@ fn bone_directions_match_the_source() {
         let (_, ends) = asf.joint_positions(&asf_pose);
         let frame = SourceFrame::from_asf(&asf, &asf_pose);
         let pose = retarget(&rig, &skel, &frame, &RetargetOptions::default()).unwrap();
-        for (rig_name, asf_name) in [("LeftUpLeg", "lfemur"), ("LeftLeg", "ltibia"), ("LHipJoint", "lhipjoint"), ("LowerBack", "lowerback")] {
+        for (rig_name, asf_name) in [
+            ("LeftUpLeg", "lfemur"),
+            ("LeftLeg", "ltibia"),
+            ("LHipJoint", "lhipjoint"),
+            ("LowerBack", "lowerback"),
+        ] {
             let (h, t) = ends[asf.bone_index(asf_name).unwrap()];
             let want = (t - h).normalize().as_vec3();
             let got = posed_dir(&rig, &pose, rig_name);
-            assert!((got - want).length() < 1e-5, "{rig_name} frame {f}: {got} vs {want}");
+            assert!(
+                (got - want).length() < 1e-5,
+                "{rig_name} frame {f}: {got} vs {want}"
+            );
         }
         // The root takes the source root's rotation; the undriven bone follows its parent.
         let world = rig.world_rotations(&pose);
@@ -53,10 +61,19 @@ fn root_translation_scales_by_leg_length() {
     let keep = RetargetOptions {
         keep_horizontal_translation: true,
     };
-    let t = retarget(&rig, &skel, &frame, &keep).unwrap().root_translation.as_dvec3();
-    let want = DVec3::new(1.0 * s * ratio, (17.0 * s - rest_h) * ratio, 2.0 * s * ratio);
+    let t = retarget(&rig, &skel, &frame, &keep)
+        .unwrap()
+        .root_translation
+        .as_dvec3();
+    let want = DVec3::new(
+        1.0 * s * ratio,
+        (17.0 * s - rest_h) * ratio,
+        2.0 * s * ratio,
+    );
     assert!((t - want).length() < 1e-5, "{t} vs {want}");
-    let t = retarget(&rig, &skel, &frame, &RetargetOptions::default()).unwrap().root_translation;
+    let t = retarget(&rig, &skel, &frame, &RetargetOptions::default())
+        .unwrap()
+        .root_translation;
     assert!(t.x == 0.0 && t.z == 0.0 && (t.y as f64 - want.y).abs() < 1e-6);
 }
 
@@ -76,15 +93,24 @@ fn antiparallel_and_degenerate_bones_do_not_fail() {
         root_position: DVec3::new(0.0, 1.0, 0.0),
     };
     let pose = retarget(&rig, &skel, &frame, &RetargetOptions::default()).unwrap();
-    assert!(pose.rotations.iter().all(|q| q.is_finite() && q.is_normalized()));
+    assert!(pose
+        .rotations
+        .iter()
+        .all(|q| q.is_finite() && q.is_normalized()));
     let up = posed_dir(&rig, &pose, "LeftUpLeg");
     assert!((up - (g * DVec3::Y).as_vec3()).length() < 1e-4);
     let bad = SourceFrame {
         world: vec![DQuat::IDENTITY],
         root_position: DVec3::ZERO,
     };
-    assert!(matches!(retarget(&rig, &skel, &bad, &RetargetOptions::default()), Err(PoseError::Invalid(_))));
+    assert!(matches!(
+        retarget(&rig, &skel, &bad, &RetargetOptions::default()),
+        Err(PoseError::Invalid(_))
+    ));
     let empty = Rig { bones: vec![] };
-    assert!(matches!(retarget(&empty, &skel, &frame, &RetargetOptions::default()), Err(PoseError::Rig(_))));
+    assert!(matches!(
+        retarget(&empty, &skel, &frame, &RetargetOptions::default()),
+        Err(PoseError::Rig(_))
+    ));
     let _ = Quat::IDENTITY;
 }

@@ -158,7 +158,11 @@ impl AnatomicalPose {
         let mut world: Vec<DQuat> = Vec::with_capacity(BONES);
         for (i, (bone, j)) in CMU_BONES.iter().zip(&self.joints).enumerate() {
             let [fx, ax, tx] = axes(i);
-            let m = if mirror_index(i) < i { DVec3::new(-1.0, 1.0, 1.0) } else { DVec3::ONE };
+            let m = if mirror_index(i) < i {
+                DVec3::new(-1.0, 1.0, 1.0)
+            } else {
+                DVec3::ONE
+            };
             // Mirroring a rotation about `a` by `t` gives one about `M a` by `-t`.
             let sign = if m.x < 0.0 { -1.0 } else { 1.0 };
             let r = |axis: DVec3, t: f32| DQuat::from_axis_angle(axis * m, sign * t as f64);
@@ -176,7 +180,8 @@ impl AnatomicalPose {
             world: self.canonical_world(),
             root_position: DVec3::ZERO,
         };
-        retarget_rotations(rig, &skeleton, &frame).unwrap_or_else(|_| vec![glam::Quat::IDENTITY; rig.len()])
+        retarget_rotations(rig, &skeleton, &frame)
+            .unwrap_or_else(|_| vec![glam::Quat::IDENTITY; rig.len()])
     }
 
     /// Poses `rig`: rotations from the angles, and a vertical root translation that puts
@@ -210,10 +215,18 @@ fn canonical_skeleton(rig: &Rig) -> SourceSkeleton {
                 | "RightForeArm" | "RightHand" | "RightFingerBase" | "RightHandFinger1" => down,
                 "LeftFoot" | "LeftToeBase" | "RightFoot" | "RightToeBase" => {
                     let s = DVec3::new(0.0, v.y, v.z);
-                    if s.length() > 1e-9 { s.normalize() * v.length() } else { v }
+                    if s.length() > 1e-9 {
+                        s.normalize() * v.length()
+                    } else {
+                        v
+                    }
                 }
                 "LThumb" | "RThumb" => {
-                    let hand = rest(if b.name == "LThumb" { "LeftHand" } else { "RightHand" });
+                    let hand = rest(if b.name == "LThumb" {
+                        "LeftHand"
+                    } else {
+                        "RightHand"
+                    });
                     if hand.length() > 1e-9 {
                         DQuat::from_rotation_arc(hand.normalize(), -DVec3::Y) * v
                     } else {
@@ -275,9 +288,13 @@ fn floor_offset(rig: &Rig, pose: &Pose) -> f32 {
     floor - lowest
 }
 
-/// Posed foot landmark heights above the rest floor `[marks]` (for tests and tuning).
+/// Posed foot landmark heights above the rest floor `[marks]` (for tests).
+#[cfg(test)]
 pub(crate) fn foot_heights(rig: &Rig, pose: &Pose) -> Vec<f32> {
     let (marks, floor) = foot_landmarks(rig);
     let xf = rig.skinning_transforms(pose);
-    marks.iter().map(|&(b, p)| xf[b].apply(p).y - floor).collect()
+    marks
+        .iter()
+        .map(|&(b, p)| xf[b].apply(p).y - floor)
+        .collect()
 }

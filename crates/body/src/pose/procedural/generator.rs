@@ -88,10 +88,16 @@ impl ProceduralPoseGenerator {
     pub fn anatomical_at(&self, index: u64, leg_length: f32) -> AnatomicalPose {
         let mut rng = StdRng::seed_from_u64(mix(self.seed ^ mix(index)));
         let kind = match self.kind {
-            PoseKind::Any => [PoseKind::Walk, PoseKind::Yoga, PoseKind::Dance][rng.random_range(0..3)],
+            PoseKind::Any => {
+                [PoseKind::Walk, PoseKind::Yoga, PoseKind::Dance][rng.random_range(0..3)]
+            }
             k => k,
         };
-        let leg = if leg_length.is_finite() && leg_length > 0.1 { leg_length } else { 0.85 };
+        let leg = if leg_length.is_finite() && leg_length > 0.1 {
+            leg_length
+        } else {
+            0.85
+        };
         let (pose, noise) = match kind {
             PoseKind::Walk => (random_walk(&mut rng, leg), 0.4),
             PoseKind::Yoga => (random_key(&mut rng, PoseFamily::Yoga), 1.0),
@@ -154,7 +160,11 @@ fn random_key(rng: &mut StdRng, family: PoseFamily) -> AnatomicalPose {
     let members = KeyPose::family_members(family);
     let pick = |rng: &mut StdRng| {
         let p = members[rng.random_range(0..members.len())].pose();
-        if rng.random_bool(0.5) { p.mirrored() } else { p }
+        if rng.random_bool(0.5) {
+            p.mirrored()
+        } else {
+            p
+        }
     };
     let main = pick(rng);
     if rng.random_bool(0.5) {

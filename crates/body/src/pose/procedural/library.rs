@@ -67,7 +67,10 @@ impl KeyPose {
 
     /// The key poses of one family.
     pub fn family_members(family: PoseFamily) -> Vec<KeyPose> {
-        Self::ALL.into_iter().filter(|k| k.family() == family).collect()
+        Self::ALL
+            .into_iter()
+            .filter(|k| k.family() == family)
+            .collect()
     }
 
     /// The family of the pose.
@@ -82,6 +85,7 @@ impl KeyPose {
     }
 
     /// `(bone, flex, abd, twist)` in degrees.
+    #[rustfmt::skip]
     fn table(self) -> &'static [(&'static str, f32, f32, f32)] {
         use KeyPose::*;
         match self {

@@ -6,9 +6,9 @@ mod anatomy;
 mod generator;
 mod library;
 mod limits;
-mod walk;
 #[cfg(test)]
 mod tests;
+mod walk;
 
 pub use anatomy::{AnatomicalPose, JointAngles, BONES};
 pub use generator::{PoseKind, ProceduralPoseGenerator};

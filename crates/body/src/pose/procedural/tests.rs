@@ -34,9 +34,12 @@ fn anatomical_signs() {
     let knee = [("LeftLeg", 90.0, 0.0, 0.0)];
     assert!(moved(&rig, &knee, "LeftFoot", false).z < -0.2);
     let internal = [("LeftUpLeg", 0.0, 0.0, 40.0), ("LeftLeg", 90.0, 0.0, 0.0)];
-    assert!(moved(&rig, &internal, "LeftFoot", false).x - moved(&rig, &knee, "LeftFoot", false).x > up);
+    assert!(
+        moved(&rig, &internal, "LeftFoot", false).x - moved(&rig, &knee, "LeftFoot", false).x > up
+    );
     let toes_down = [("LeftFoot", 30.0, 0.0, 0.0)];
-    let d = moved(&rig, &toes_down, "LeftToeBase", true) - moved(&rig, &toes_down, "LeftFoot", false);
+    let d =
+        moved(&rig, &toes_down, "LeftToeBase", true) - moved(&rig, &toes_down, "LeftFoot", false);
     assert!(d.y < -0.03);
     let raised = moved(&rig, &[("LeftArm", 0.0, 90.0, 0.0)], "LeftForeArm", false);
     assert!(raised.y > 0.2 && raised.x > 0.2, "{raised}");
@@ -49,7 +52,10 @@ fn anatomical_signs() {
     assert!(moved(&rig, &[("Spine1", 0.0, 0.0, 30.0)], "LeftArm", false).z < -up);
     // Neutral: arms hang straight down from the shoulders, legs straight.
     let n = AnatomicalPose::neutral().to_pose(&rig);
-    let (sh, hand) = (joint(&rig, &n, "LeftArm", false), joint(&rig, &n, "LeftHand", false));
+    let (sh, hand) = (
+        joint(&rig, &n, "LeftArm", false),
+        joint(&rig, &n, "LeftHand", false),
+    );
     assert!((sh.x - hand.x).abs() < 1e-3 && (sh.z - hand.z).abs() < 1e-3 && hand.y < sh.y - 0.4);
 }
 
@@ -80,7 +86,10 @@ fn key_poses_are_within_limits_and_stand_on_the_floor() {
         let pose = a.to_pose(&rig);
         let feet = foot_heights(&rig, &pose);
         let lowest = feet.iter().copied().fold(f32::INFINITY, f32::min);
-        assert!(lowest.abs() < 1e-4 && feet.iter().all(|h| *h > -1e-4), "{k:?}: {feet:?}");
+        assert!(
+            lowest.abs() < 1e-4 && feet.iter().all(|h| *h > -1e-4),
+            "{k:?}: {feet:?}"
+        );
         let head = joint(&rig, &pose, "Head", true);
         assert!(head.y > joint(&rig, &pose, "Hips", false).y, "{k:?}");
     }
@@ -102,17 +111,27 @@ fn walk_cycle_is_periodic_and_symmetric() {
             ..Default::default()
         };
         let a = walk_pose(&p);
-        let b = walk_pose(&WalkParams { phase: phase + 1.0, ..p });
-        let c = walk_pose(&WalkParams { phase: phase + 0.5, ..p });
+        let b = walk_pose(&WalkParams {
+            phase: phase + 1.0,
+            ..p
+        });
+        let c = walk_pose(&WalkParams {
+            phase: phase + 0.5,
+            ..p
+        });
         let close = |x: &AnatomicalPose, y: &AnatomicalPose| {
-            x.joints.iter().zip(&y.joints).all(|(u, v)| {
-                (0..3).all(|k| (u.to_array()[k] - v.to_array()[k]).abs() < 1e-4)
-            })
+            x.joints
+                .iter()
+                .zip(&y.joints)
+                .all(|(u, v)| (0..3).all(|k| (u.to_array()[k] - v.to_array()[k]).abs() < 1e-4))
         };
         assert!(close(&a, &b) && close(&c, &a.mirrored()), "phase {phase}");
         assert!(JointLimits::default().contains(&a, 1e-4));
         let feet = foot_heights(&rig, &a.to_pose(&rig));
-        assert!(feet.iter().all(|h| *h > -1e-4 && *h < 0.3), "phase {phase}: {feet:?}");
+        assert!(
+            feet.iter().all(|h| *h > -1e-4 && *h < 0.3),
+            "phase {phase}: {feet:?}"
+        );
     }
     let hip_range = |stride: f32| {
         let v: Vec<f32> = (0..20)
@@ -135,7 +154,12 @@ fn walk_cycle_is_periodic_and_symmetric() {
 #[test]
 fn generator_is_reproducible_and_plausible() {
     let rig = a_pose_rig();
-    for kind in [PoseKind::Walk, PoseKind::Yoga, PoseKind::Dance, PoseKind::Any] {
+    for kind in [
+        PoseKind::Walk,
+        PoseKind::Yoga,
+        PoseKind::Dance,
+        PoseKind::Any,
+    ] {
         let mut g = ProceduralPoseGenerator::new(42, kind);
         let mut h = ProceduralPoseGenerator::new(42, kind);
         let other = ProceduralPoseGenerator::new(43, kind);
@@ -148,7 +172,10 @@ fn generator_is_reproducible_and_plausible() {
             let feet = foot_heights(&rig, &p);
             assert!(feet.iter().copied().fold(f32::INFINITY, f32::min).abs() < 1e-4);
             let head = joint(&rig, &p, "Head", true);
-            assert!(head.y > joint(&rig, &p, "Hips", false).y + 0.2, "{kind:?} {i}");
+            assert!(
+                head.y > joint(&rig, &p, "Hips", false).y + 0.2,
+                "{kind:?} {i}"
+            );
             assert!(p.rotations.iter().all(|q| q.is_finite()));
         }
     }

@@ -56,16 +56,34 @@ fn leg(phase: f32, k: f32) -> (f32, f32, f32, f32) {
 /// The anatomical pose of a walk at `p.phase`. The pose does not depend on cadence;
 /// stride and arm swing scale the amplitudes.
 pub fn walk_pose(p: &WalkParams) -> AnatomicalPose {
-    let phase = if p.phase.is_finite() { p.phase.rem_euclid(1.0) } else { 0.0 };
-    let ratio = if p.leg_length > 0.0 { p.stride_length / p.leg_length } else { 1.65 };
+    let phase = if p.phase.is_finite() {
+        p.phase.rem_euclid(1.0)
+    } else {
+        0.0
+    };
+    let ratio = if p.leg_length > 0.0 {
+        p.stride_length / p.leg_length
+    } else {
+        1.65
+    };
     let k = (ratio / 1.65).clamp(0.15, 1.6);
-    let swing = if p.arm_swing.is_finite() { p.arm_swing.clamp(0.0, 2.0) } else { 1.0 };
+    let swing = if p.arm_swing.is_finite() {
+        p.arm_swing.clamp(0.0, 2.0)
+    } else {
+        1.0
+    };
     let mut pose = AnatomicalPose::neutral();
     let pelvis_turn = -4.0 * k * cos_turn(phase);
     let list = 3.0 * k * (bump(phase, 0.15, 0.08) - bump(phase, 0.65, 0.08));
     pose.set("Hips", JointAngles::deg(2.0, -list, pelvis_turn));
-    pose.set("LowerBack", JointAngles::deg(0.0, 0.6 * list, -0.5 * pelvis_turn));
-    pose.set("Spine", JointAngles::deg(2.0, 0.4 * list, -0.5 * pelvis_turn));
+    pose.set(
+        "LowerBack",
+        JointAngles::deg(0.0, 0.6 * list, -0.5 * pelvis_turn),
+    );
+    pose.set(
+        "Spine",
+        JointAngles::deg(2.0, 0.4 * list, -0.5 * pelvis_turn),
+    );
     pose.set("Spine1", JointAngles::deg(1.0, 0.0, -0.5 * pelvis_turn));
     pose.set("Neck", JointAngles::deg(-3.0, 0.0, 0.5 * pelvis_turn));
     for (side, offset) in [("Left", 0.0), ("Right", 0.5)] {
@@ -78,10 +96,19 @@ pub fn walk_pose(p: &WalkParams) -> AnatomicalPose {
         let shoulder = -swing * k * 18.0 * cos_turn(ph - 0.97);
         pose.set(&format!("{side}Arm"), JointAngles::deg(shoulder, 8.0, 0.0));
         let elbow = 12.0 + 0.6 * shoulder.max(0.0) + 4.0 * swing;
-        pose.set(&format!("{side}ForeArm"), JointAngles::deg(elbow, 0.0, 10.0));
+        pose.set(
+            &format!("{side}ForeArm"),
+            JointAngles::deg(elbow, 0.0, 10.0),
+        );
         pose.set(&format!("{side}Hand"), JointAngles::deg(8.0, 0.0, 0.0));
-        pose.set(&format!("{side}FingerBase"), JointAngles::deg(10.0, 0.0, 0.0));
-        pose.set(&format!("{side}HandFinger1"), JointAngles::deg(15.0, 0.0, 0.0));
+        pose.set(
+            &format!("{side}FingerBase"),
+            JointAngles::deg(10.0, 0.0, 0.0),
+        );
+        pose.set(
+            &format!("{side}HandFinger1"),
+            JointAngles::deg(15.0, 0.0, 0.0),
+        );
     }
     pose
 }
