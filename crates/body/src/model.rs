@@ -90,16 +90,24 @@ impl BodyModel {
     pub fn from_file(path: &Path) -> Result<Self, BodyError> {
         let bytes = std::fs::read(path).map_err(|e| BodyError::asset(path, e.to_string()))?;
         let bad = |m: String| BodyError::asset(path, m);
-        let (_, meta) = SafeTensors::read_metadata(&bytes).map_err(|e| bad(format!("not a body file: {e}")))?;
+        let (_, meta) =
+            SafeTensors::read_metadata(&bytes).map_err(|e| bad(format!("not a body file: {e}")))?;
         let meta = meta.metadata().clone().unwrap_or_default();
         if meta.get("format").map(String::as_str) != Some(FORMAT) {
-            return Err(bad(format!("not a {FORMAT} file; delete it to convert again")));
+            return Err(bad(format!(
+                "not a {FORMAT} file; delete it to convert again"
+            )));
         }
         let st = SafeTensors::deserialize(&bytes).map_err(|e| bad(e.to_string()))?;
         let get = |name: &str, dtype: Dtype| -> Result<TensorView<'_>, BodyError> {
-            let t = st.tensor(name).map_err(|_| bad(format!("missing tensor {name}")))?;
+            let t = st
+                .tensor(name)
+                .map_err(|_| bad(format!("missing tensor {name}")))?;
             if t.dtype() != dtype {
-                return Err(bad(format!("tensor {name} has dtype {:?}, expected {dtype:?}", t.dtype())));
+                return Err(bad(format!(
+                    "tensor {name} has dtype {:?}, expected {dtype:?}",
+                    t.dtype()
+                )));
             }
             Ok(t)
         };
@@ -111,21 +119,33 @@ impl BodyModel {
             .chunks_exact(3)
             .map(|c| [c[0], c[1], c[2]])
             .collect();
-        let bones: Vec<BoneDef> = serde_json::from_str(meta.get("bones").ok_or_else(|| bad("no bones metadata".into()))?)
-            .map_err(|e| bad(format!("bones metadata: {e}")))?;
-        let tpose_map: HashMap<String, [f32; 3]> =
-            serde_json::from_str(meta.get("tpose").ok_or_else(|| bad("no tpose metadata".into()))?)
-                .map_err(|e| bad(format!("tpose metadata: {e}")))?;
+        let bones: Vec<BoneDef> = serde_json::from_str(
+            meta.get("bones")
+                .ok_or_else(|| bad("no bones metadata".into()))?,
+        )
+        .map_err(|e| bad(format!("bones metadata: {e}")))?;
+        let tpose_map: HashMap<String, [f32; 3]> = serde_json::from_str(
+            meta.get("tpose")
+                .ok_or_else(|| bad("no tpose metadata".into()))?,
+        )
+        .map_err(|e| bad(format!("tpose metadata: {e}")))?;
         let mut tpose = Vec::new();
         for (name, e) in tpose_map {
-            let b = bones.iter().position(|b| b.name == name).ok_or_else(|| bad(format!("tpose names unknown bone {name}")))?;
+            let b = bones
+                .iter()
+                .position(|b| b.name == name)
+                .ok_or_else(|| bad(format!("tpose names unknown bone {name}")))?;
             tpose.push((b, Vec3::from(e)));
         }
         let reg_off = u32s(get("regressors.offsets", Dtype::U32)?.data());
         let reg_idx = u32s(get("regressors.indices", Dtype::U32)?.data());
         let regressors = reg_off
             .windows(2)
-            .map(|w| reg_idx.get(w[0] as usize..w[1] as usize).map(<[u32]>::to_vec))
+            .map(|w| {
+                reg_idx
+                    .get(w[0] as usize..w[1] as usize)
+                    .map(<[u32]>::to_vec)
+            })
             .collect::<Option<Vec<_>>>()
             .ok_or_else(|| bad("regressor offsets out of range".into()))?;
         let weights = SkinWeights {
@@ -135,18 +155,34 @@ impl BodyModel {
         };
         let mut targets = Vec::new();
         for (name, _) in st.tensors() {
-            let Some(tname) = name.strip_prefix("target/").and_then(|n| n.strip_suffix("/index")) else {
+            let Some(tname) = name
+                .strip_prefix("target/")
+                .and_then(|n| n.strip_suffix("/index"))
+            else {
                 continue;
             };
             let index = u16s(get(&name, Dtype::U16)?.data());
-            let delta: Vec<[i16; 3]> = i16s(get(&format!("target/{tname}/delta"), Dtype::I16)?.data())
-                .chunks_exact(3)
-                .map(|c| [c[0], c[1], c[2]])
-                .collect();
-            targets.push(Target { name: tname.to_string(), index, delta });
+            let delta: Vec<[i16; 3]> =
+                i16s(get(&format!("target/{tname}/delta"), Dtype::I16)?.data())
+                    .chunks_exact(3)
+                    .map(|c| [c[0], c[1], c[2]])
+                    .collect();
+            targets.push(Target {
+                name: tname.to_string(),
+                index,
+                delta,
+            });
         }
         targets.sort_by(|a, b| a.name.cmp(&b.name));
-        let model = Self { template, faces, targets, regressors, bones, weights: Arc::new(weights), tpose };
+        let model = Self {
+            template,
+            faces,
+            targets,
+            regressors,
+            bones,
+            weights: Arc::new(weights),
+            tpose,
+        };
         model.check().map_err(bad)?;
         Ok(model)
     }
@@ -155,15 +191,29 @@ impl BodyModel {
     fn check(&self) -> Result<(), String> {
         let v = self.template.len();
         if v < BODY_VERTEX_COUNT || self.weights.len() != BODY_VERTEX_COUNT {
-            return Err(format!("expected {BODY_VERTEX_COUNT} body vertices with weights"));
+            return Err(format!(
+                "expected {BODY_VERTEX_COUNT} body vertices with weights"
+            ));
         }
-        if self.faces.iter().flatten().any(|&i| i as usize >= BODY_VERTEX_COUNT) {
+        if self
+            .faces
+            .iter()
+            .flatten()
+            .any(|&i| i as usize >= BODY_VERTEX_COUNT)
+        {
             return Err("face index out of range".into());
         }
-        if self.regressors.len() != 2 * self.bones.len() || self.regressors.iter().flatten().any(|&i| i as usize >= v) {
+        if self.regressors.len() != 2 * self.bones.len()
+            || self.regressors.iter().flatten().any(|&i| i as usize >= v)
+        {
             return Err("bad joint regressors".into());
         }
-        if self.weights.bones.iter().any(|&b| b as usize >= self.bones.len()) {
+        if self
+            .weights
+            .bones
+            .iter()
+            .any(|&b| b as usize >= self.bones.len())
+        {
             return Err("weight names an unknown bone".into());
         }
         for t in &self.targets {
@@ -191,9 +241,19 @@ impl BodyModel {
         phenotype.validate()?;
         let mut vertices = self.template.clone();
         let weights = phenotype.label_weights();
-        let weight = |label: &str| weights.iter().find(|(l, _)| *l == label).map_or(0.0, |(_, w)| *w);
+        let weight = |label: &str| {
+            weights
+                .iter()
+                .find(|(l, _)| *l == label)
+                .map_or(0.0, |(_, w)| *w)
+        };
         for t in &self.targets {
-            let c: f32 = t.name.split('-').filter(|l| *l != "universal").map(weight).product();
+            let c: f32 = t
+                .name
+                .split('-')
+                .filter(|l| *l != "universal")
+                .map(weight)
+                .product();
             if c.abs() < 1e-7 {
                 continue;
             }
@@ -253,7 +313,9 @@ impl ShapedBody {
             .mesh
             .vertices
             .iter()
-            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), p| (lo.min(p.y), hi.max(p.y)));
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p.y), hi.max(p.y))
+            });
         hi - lo
     }
 
@@ -267,7 +329,9 @@ impl ShapedBody {
             )));
         }
         if !pose.root_translation.is_finite() || pose.rotations.iter().any(|q| !q.is_finite()) {
-            return Err(BodyError::Parameter("pose contains NaN or infinite values".into()));
+            return Err(BodyError::Parameter(
+                "pose contains NaN or infinite values".into(),
+            ));
         }
         let transforms = self.rig.skinning_transforms(pose);
         Ok(TriMesh {
@@ -289,14 +353,22 @@ impl ShapedBody {
 }
 
 fn f32s(b: &[u8]) -> Vec<f32> {
-    b.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()
+    b.chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect()
 }
 fn u32s(b: &[u8]) -> Vec<u32> {
-    b.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect()
+    b.chunks_exact(4)
+        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect()
 }
 fn u16s(b: &[u8]) -> Vec<u16> {
-    b.chunks_exact(2).map(|c| u16::from_le_bytes([c[0], c[1]])).collect()
+    b.chunks_exact(2)
+        .map(|c| u16::from_le_bytes([c[0], c[1]]))
+        .collect()
 }
 fn i16s(b: &[u8]) -> Vec<i16> {
-    b.chunks_exact(2).map(|c| i16::from_le_bytes([c[0], c[1]])).collect()
+    b.chunks_exact(2)
+        .map(|c| i16::from_le_bytes([c[0], c[1]]))
+        .collect()
 }

@@ -184,10 +184,19 @@ mod tests {
 
     #[test]
     fn interpolation_is_piecewise_linear_and_partitions_unity() {
-        assert_eq!(interpolation_weights(0.5, AGE.anchors)[1], 0.5);
-        assert_eq!(interpolation_weights(0.5, AGE.anchors)[2], 0.5);
-        assert_eq!(interpolation_weights(0.0, MUSCLE.anchors), vec![1.0, 0.0, 0.0]);
-        assert_eq!(interpolation_weights(2.0, MUSCLE.anchors), vec![0.0, 0.0, 1.0]);
+        let mid = interpolation_weights(0.5, AGE.anchors);
+        assert!(
+            (mid[1] - 0.5).abs() < 1e-6 && (mid[2] - 0.5).abs() < 1e-6,
+            "{mid:?}"
+        );
+        assert_eq!(
+            interpolation_weights(0.0, MUSCLE.anchors),
+            vec![1.0, 0.0, 0.0]
+        );
+        assert_eq!(
+            interpolation_weights(2.0, MUSCLE.anchors),
+            vec![0.0, 0.0, 1.0]
+        );
         let w = interpolation_weights(0.75, WEIGHT.anchors);
         assert!((w[1] - 0.5).abs() < 1e-6 && (w[2] - 0.5).abs() < 1e-6);
         for v in [0.0, 0.1, 0.33, 0.5, 0.9, 1.0] {
@@ -208,8 +217,13 @@ mod tests {
             .target_coefficient("universal-female-young-averagemuscle-maxweight")
             .unwrap();
         assert!((c - 0.5).abs() < 1e-5);
-        assert_eq!(p.target_coefficient("male-young-averagemuscle-averageweight-maxheight"), Some(0.0));
-        let r = Phenotype::default().target_coefficient("asian-female-young").unwrap();
+        assert_eq!(
+            p.target_coefficient("male-young-averagemuscle-averageweight-maxheight"),
+            Some(0.0)
+        );
+        let r = Phenotype::default()
+            .target_coefficient("asian-female-young")
+            .unwrap();
         assert!((r - 1.0 / 3.0 * 0.5 * 0.5).abs() < 1e-6);
         assert_eq!(p.target_coefficient("female-teen"), None);
     }
@@ -217,9 +231,15 @@ mod tests {
     #[test]
     fn validation_rejects_nan_and_out_of_range() {
         assert!(Phenotype::default().validate().is_ok());
-        let bad = Phenotype { height: f32::NAN, ..Default::default() };
+        let bad = Phenotype {
+            height: f32::NAN,
+            ..Default::default()
+        };
         assert!(bad.validate().unwrap_err().to_string().contains("height"));
-        let bad = Phenotype { weight: 1.5, ..Default::default() };
+        let bad = Phenotype {
+            weight: 1.5,
+            ..Default::default()
+        };
         assert!(bad.validate().is_err());
     }
 }

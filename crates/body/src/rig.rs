@@ -28,6 +28,7 @@ pub struct Bone {
 /// A skeleton in its rest pose: bones in parent-before-child order.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Rig {
+    /// `[B]` bones, parents before children.
     pub bones: Vec<Bone>,
 }
 
@@ -35,18 +36,23 @@ pub struct Rig {
 /// world-space translation of the root bone's head (metres).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pose {
+    /// World-space offset of the root bone's head from its rest position, metres.
     pub root_translation: Vec3,
+    /// `[B]` bone-local rotations (in each bone's rest frame), rig bone order.
     pub rotations: Vec<Quat>,
 }
 
 /// A rigid transform `x -> rotation * x + translation` (metres).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RigidTransform {
+    /// Rotation part.
     pub rotation: Quat,
+    /// Translation part, metres.
     pub translation: Vec3,
 }
 
 impl RigidTransform {
+    /// The transform that moves nothing.
     pub const IDENTITY: Self = Self {
         rotation: Quat::IDENTITY,
         translation: Vec3::ZERO,
@@ -182,7 +188,11 @@ impl Rig {
     /// Every bone's head follows its parent's transform; the root's head moves by
     /// `pose.root_translation`.
     pub fn skinning_transforms(&self, pose: &Pose) -> Vec<RigidTransform> {
-        assert_eq!(pose.rotations.len(), self.bones.len(), "pose/rig bone count");
+        assert_eq!(
+            pose.rotations.len(),
+            self.bones.len(),
+            "pose/rig bone count"
+        );
         let world = self.world_rotations(pose);
         let mut out: Vec<RigidTransform> = Vec::with_capacity(self.bones.len());
         for (bone, &rotation) in self.bones.iter().zip(&world) {

@@ -15,12 +15,29 @@ use crate::model::ShapedBody;
 
 /// Segment names, indexed by segment number.
 pub const SEGMENTS: [&str; 9] = [
-    "torso", "left upper arm", "left forearm", "right upper arm", "right forearm",
-    "left thigh", "left shin", "right thigh", "right shin",
+    "torso",
+    "left upper arm",
+    "left forearm",
+    "right upper arm",
+    "right forearm",
+    "left thigh",
+    "left shin",
+    "right thigh",
+    "right shin",
 ];
 
 /// Pairs of segments that touch in the body (their contact is not an intersection).
-const NEIGHBOURS: [(u8, u8); 9] = [(0, 1), (1, 2), (0, 3), (3, 4), (0, 5), (5, 6), (0, 7), (7, 8), (5, 7)];
+const NEIGHBOURS: [(u8, u8); 9] = [
+    (0, 1),
+    (1, 2),
+    (0, 3),
+    (3, 4),
+    (0, 5),
+    (5, 6),
+    (0, 7),
+    (7, 8),
+    (5, 7),
+];
 
 /// Segment of a rig bone by name.
 pub fn segment_of_bone(name: &str) -> u8 {
@@ -28,7 +45,13 @@ pub fn segment_of_bone(name: &str) -> u8 {
     let side = |l: u8, r: u8| if left { l } else { r };
     match name {
         n if n.ends_with("Arm") && !n.ends_with("ForeArm") => side(1, 3),
-        n if n.ends_with("ForeArm") || n.contains("Hand") || n.contains("Finger") || n.contains("Thumb") => side(2, 4),
+        n if n.ends_with("ForeArm")
+            || n.contains("Hand")
+            || n.contains("Finger")
+            || n.contains("Thumb") =>
+        {
+            side(2, 4)
+        }
         n if n.ends_with("UpLeg") => side(5, 7),
         n if n.ends_with("Leg") || n.ends_with("Foot") || n.ends_with("ToeBase") => side(6, 8),
         _ => 0,
@@ -45,16 +68,28 @@ pub struct SelfContact {
 }
 
 fn neighbours(a: u8, b: u8) -> bool {
-    a == b || NEIGHBOURS.iter().any(|&(x, y)| (x, y) == (a, b) || (y, x) == (a, b))
+    a == b
+        || NEIGHBOURS
+            .iter()
+            .any(|&(x, y)| (x, y) == (a, b) || (y, x) == (a, b))
 }
 
 impl SelfContact {
     /// Segments the vertices of `body` by their heaviest bone.
     pub fn new(body: &ShapedBody) -> Self {
-        let bone_segment: Vec<u8> = body.rig.bones.iter().map(|b| segment_of_bone(&b.name)).collect();
+        let bone_segment: Vec<u8> = body
+            .rig
+            .bones
+            .iter()
+            .map(|b| segment_of_bone(&b.name))
+            .collect();
         let vertex_segment: Vec<u8> = (0..body.weights.len())
             .map(|v| {
-                let (bone, _) = body.weights.row(v).fold((0, -1.0), |best, (b, w)| if w > best.1 { (b, w) } else { best });
+                let (bone, _) =
+                    body.weights.row(v).fold(
+                        (0, -1.0),
+                        |best, (b, w)| if w > best.1 { (b, w) } else { best },
+                    );
                 bone_segment[bone]
             })
             .collect();
@@ -62,7 +97,10 @@ impl SelfContact {
             .into_iter()
             .filter(|e| vertex_segment[e[0] as usize] == vertex_segment[e[1] as usize])
             .collect();
-        Self { vertex_segment, edges }
+        Self {
+            vertex_segment,
+            edges,
+        }
     }
 
     /// Number of edges of one segment that cross a triangle of a non-neighbouring
@@ -75,19 +113,24 @@ impl SelfContact {
             (seg[f[1] as usize] == s && seg[f[2] as usize] == s).then_some(s)
         };
         // Only segments whose boxes overlap a non-neighbour's box can intersect.
-        let mut boxes = [(Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)); SEGMENTS.len()];
+        let mut boxes =
+            [(Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)); SEGMENTS.len()];
         for (p, &s) in posed.vertices.iter().zip(seg) {
             let b = &mut boxes[s as usize];
             *b = (b.0.min(*p), b.1.max(*p));
         }
-        let overlap = |a: usize, b: usize| (boxes[a].0.cmple(boxes[b].1) & boxes[b].0.cmple(boxes[a].1)).all();
+        let overlap = |a: usize, b: usize| {
+            (boxes[a].0.cmple(boxes[b].1) & boxes[b].0.cmple(boxes[a].1)).all()
+        };
         let risky: Vec<bool> = (0..SEGMENTS.len())
             .map(|a| (0..SEGMENTS.len()).any(|b| !neighbours(a as u8, b as u8) && overlap(a, b)))
             .collect();
         if !risky.iter().any(|&r| r) {
             return 0;
         }
-        let Ok(bvh) = Bvh::from_mesh(posed) else { return 0 };
+        let Ok(bvh) = Bvh::from_mesh(posed) else {
+            return 0;
+        };
         self.edges
             .iter()
             .filter(|e| risky[seg[e[0] as usize] as usize])

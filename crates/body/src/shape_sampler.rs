@@ -80,9 +80,15 @@ impl ShapeDistribution {
     pub fn sample(&self, model: &BodyModel, seed: u64) -> Result<ShapeSample, BodyError> {
         let mut rng = StdRng::seed_from_u64(seed);
         let female = rng.random::<f32>() < self.female_share;
-        let (mean, sd) = if female { self.female_stature } else { self.male_stature };
-        let stature_dist = Normal::new(mean, sd).map_err(|e| BodyError::Parameter(format!("stature: {e}")))?;
-        let bmi_dist = LogNormal::new(self.bmi.0.ln(), self.bmi.1).map_err(|e| BodyError::Parameter(format!("bmi: {e}")))?;
+        let (mean, sd) = if female {
+            self.female_stature
+        } else {
+            self.male_stature
+        };
+        let stature_dist =
+            Normal::new(mean, sd).map_err(|e| BodyError::Parameter(format!("stature: {e}")))?;
+        let bmi_dist = LogNormal::new(self.bmi.0.ln(), self.bmi.1)
+            .map_err(|e| BodyError::Parameter(format!("bmi: {e}")))?;
         let target_stature = loop {
             let s = stature_dist.sample(&mut rng);
             if (s - mean).abs() <= self.max_sigma * sd {
@@ -97,9 +103,14 @@ impl ShapeDistribution {
         };
         let shares: [f32; 3] = std::array::from_fn(|_| rng.random::<f32>() + 0.05);
         let mut phenotype = Phenotype {
-            gender: if female { rng.random_range(0.9..=1.0) } else { rng.random_range(0.0..=0.1) },
+            gender: if female {
+                rng.random_range(0.9..=1.0)
+            } else {
+                rng.random_range(0.0..=0.1)
+            },
             age: rng.random_range(self.age_range.0..=self.age_range.1),
-            muscle: (0.5 + self.muscle_sd * Normal::new(0.0f32, 1.0).unwrap().sample(&mut rng)).clamp(0.05, 0.95),
+            muscle: (0.5 + self.muscle_sd * Normal::new(0.0f32, 1.0).unwrap().sample(&mut rng))
+                .clamp(0.05, 0.95),
             proportions: rng.random_range(0.0..=0.5),
             cupsize: rng.random_range(0.3..=0.8),
             firmness: rng.random_range(0.3..=0.8),
@@ -108,8 +119,15 @@ impl ShapeDistribution {
             caucasian: shares[2],
             ..Phenotype::default()
         };
-        let (stature, bmi) = solve_height_weight(model, &mut phenotype, target_stature, target_bmi)?;
-        Ok(ShapeSample { phenotype, target_stature, stature, target_bmi, bmi })
+        let (stature, bmi) =
+            solve_height_weight(model, &mut phenotype, target_stature, target_bmi)?;
+        Ok(ShapeSample {
+            phenotype,
+            target_stature,
+            stature,
+            target_bmi,
+            bmi,
+        })
     }
 }
 
@@ -123,9 +141,17 @@ pub fn solve_height_weight(
     stature: f32,
     bmi: f32,
 ) -> Result<(f32, f32), BodyError> {
-    let mut cur = newton_height_and(model, p, stature, bmi, |p| &mut p.weight)?;
+    let mut cur = newton_height_and(model, p, stature, bmi, |p| &mut p.weight, 1.0)?;
     if p.weight >= 1.0 && cur.1 < bmi - 0.2 {
-        cur = newton_height_and(model, p, stature, bmi, |p| &mut p.muscle)?;
+        // Heavier still: some more muscle, short of a body-builder's build.
+        cur = newton_height_and(
+            model,
+            p,
+            stature,
+            bmi,
+            |p| &mut p.muscle,
+            MAX_FALLBACK_MUSCLE.max(p.muscle),
+        )?;
     }
     // Where the mass parameters saturated, stature still wins: secant on height alone.
     let mut prev = (p.height, cur.0);
@@ -134,7 +160,11 @@ pub fn solve_height_weight(
             break;
         }
         let h = p.height;
-        let slope = if prev.0 != h { (cur.0 - prev.1) / (h - prev.0) } else { 0.5 };
+        let slope = if prev.0 != h {
+            (cur.0 - prev.1) / (h - prev.0)
+        } else {
+            0.5
+        };
         p.height = (h + (stature - cur.0) / slope.max(0.05)).clamp(0.0, 1.0);
         prev = (h, cur.0);
         cur = stature_and_bmi(&model.shape(p)?);
@@ -142,22 +172,29 @@ pub fn solve_height_weight(
     Ok(cur)
 }
 
-/// Newton iterations on (height, `second`) with a finite-difference Jacobian.
+/// The most muscle the BMI solve adds when the heaviest `weight` is not enough.
+const MAX_FALLBACK_MUSCLE: f32 = 0.7;
+
+/// Newton iterations on (height, `second`) with a finite-difference Jacobian; `second`
+/// stays in [0, `second_max`].
 fn newton_height_and(
     model: &BodyModel,
     p: &mut Phenotype,
     stature: f32,
     bmi: f32,
     second: fn(&mut Phenotype) -> &mut f32,
+    second_max: f32,
 ) -> Result<(f32, f32), BodyError> {
     const STEP: f32 = 0.05;
-    let eval = |p: &Phenotype| -> Result<(f32, f32), BodyError> { Ok(stature_and_bmi(&model.shape(p)?)) };
+    let eval =
+        |p: &Phenotype| -> Result<(f32, f32), BodyError> { Ok(stature_and_bmi(&model.shape(p)?)) };
     // Finite-difference column for one parameter: d(stature, bmi)/d parameter, stepping
     // backwards at the upper bound.
     let column = |p: &Phenotype, cur: (f32, f32), get: fn(&mut Phenotype) -> &mut f32| {
         let mut q = *p;
         let x = *get(&mut q);
         let h = if x + STEP <= 1.0 { STEP } else { -STEP };
+        // (Stepping past `second_max` only probes the slope.)
         *get(&mut q) = x + h;
         eval(&q).map(|d| ((d.0 - cur.0) / h, (d.1 - cur.1) / h))
     };
@@ -175,7 +212,7 @@ fn newton_height_and(
         }
         let (old_h, old_x) = (p.height, *second(p));
         p.height = (old_h + (d * r.0 - b * r.1) / det).clamp(0.0, 1.0);
-        *second(p) = (old_x + (-c * r.0 + a * r.1) / det).clamp(0.0, 1.0);
+        *second(p) = (old_x + (-c * r.0 + a * r.1) / det).clamp(0.0, second_max);
         cur = eval(p)?;
         if p.height == old_h && *second(p) == old_x {
             break;

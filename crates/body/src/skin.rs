@@ -72,8 +72,17 @@ impl SkinWeights {
 
     /// Skins rest positions `rest` `[N]` with per-bone `transforms` `[B]`, returning the
     /// posed positions `[N]` (metres).
-    pub fn apply(&self, rest: &[Vec3], transforms: &[RigidTransform], method: Skinning) -> Vec<Vec3> {
-        assert_eq!(rest.len(), self.len(), "rest positions and weight rows differ");
+    pub fn apply(
+        &self,
+        rest: &[Vec3],
+        transforms: &[RigidTransform],
+        method: Skinning,
+    ) -> Vec<Vec3> {
+        assert_eq!(
+            rest.len(),
+            self.len(),
+            "rest positions and weight rows differ"
+        );
         match method {
             Skinning::Lbs => rest
                 .par_iter()
@@ -84,7 +93,7 @@ impl SkinWeights {
                 let duals: Vec<DualQuat> = transforms.iter().map(DualQuat::from_rigid).collect();
                 rest.par_iter()
                     .enumerate()
-                    .map(|(v, &p)| blend_dual(self.row(v), &duals).transform_point(p))
+                    .map(|(v, &p)| blend_dual(|| self.row(v), &duals).transform_point(p))
                     .collect()
             }
         }
@@ -118,32 +127,35 @@ impl DualQuat {
     }
 }
 
-/// Blends bone dual quaternions with weights, flipping each to the hemisphere of the
-/// heaviest influence (shortest path), then normalises by the real part's norm.
-fn blend_dual(row: impl Iterator<Item = (usize, f32)>, duals: &[DualQuat]) -> DualQuat {
-    let mut real = Quat::from_xyzw(0.0, 0.0, 0.0, 0.0);
-    let mut dual = real;
-    let mut pivot: Option<Quat> = None;
-    let mut best = -1.0f32;
-    let row: Vec<(usize, f32)> = row.collect();
-    for &(b, w) in &row {
-        if w > best {
-            best = w;
-            pivot = Some(duals[b].real);
-        }
-    }
-    let pivot = pivot.unwrap_or(Quat::IDENTITY);
-    for (b, w) in row {
+/// Blends bone dual quaternions with weights (`row` yields `(bone, weight)` and may be
+/// iterated twice), flipping each to the hemisphere of the heaviest influence (shortest
+/// path), then normalises by the real part's norm.
+fn blend_dual<I: Iterator<Item = (usize, f32)>>(
+    row: impl Fn() -> I,
+    duals: &[DualQuat],
+) -> DualQuat {
+    let zero = Quat::from_xyzw(0.0, 0.0, 0.0, 0.0);
+    let pivot = row()
+        .fold((Quat::IDENTITY, -1.0f32), |best, (b, w)| {
+            if w > best.1 {
+                (duals[b].real, w)
+            } else {
+                best
+            }
+        })
+        .0;
+    let (mut real, mut dual) = (zero, zero);
+    for (b, w) in row() {
         let q = duals[b];
         let s = if q.real.dot(pivot) < 0.0 { -w } else { w };
-        real = real + q.real * s;
-        dual = dual + q.dual * s;
+        real += q.real * s;
+        dual += q.dual * s;
     }
     let n = real.length();
     if n < 1e-12 {
         return DualQuat {
             real: Quat::IDENTITY,
-            dual: Quat::from_xyzw(0.0, 0.0, 0.0, 0.0),
+            dual: zero,
         };
     }
     DualQuat {

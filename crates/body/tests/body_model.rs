@@ -13,14 +13,21 @@ fn model() -> &'static BodyModel {
 #[test]
 fn default_phenotype_is_1626_mm_tall_closed_and_manifold() {
     let body = model().shape(&Phenotype::default()).unwrap();
-    assert!((body.height() - 1.626).abs() < 0.001, "height {}", body.height());
+    assert!(
+        (body.height() - 1.626).abs() < 0.001,
+        "height {}",
+        body.height()
+    );
     let mesh = &body.mesh;
     assert_eq!(mesh.vertices.len(), 13380);
     assert_eq!(mesh.faces.len(), 2 * 13378);
     let report = geom::adjacency::check_manifold(mesh.vertices.len(), &mesh.faces).unwrap();
     assert!(report.is_ok() && report.is_closed(), "{report:?}");
     assert_eq!(report.euler_characteristic(), 2);
-    assert!(body.volume() > 0.03, "outward orientation gives a positive volume");
+    assert!(
+        body.volume() > 0.03,
+        "outward orientation gives a positive volume"
+    );
 }
 
 #[test]
@@ -30,7 +37,11 @@ fn weights_sum_to_one_with_at_most_eight_influences() {
     assert_eq!(w.len(), 13380);
     for v in 0..w.len() {
         let row: Vec<_> = w.row(v).collect();
-        assert!(!row.is_empty() && row.len() <= 8, "vertex {v}: {} influences", row.len());
+        assert!(
+            !row.is_empty() && row.len() <= 8,
+            "vertex {v}: {} influences",
+            row.len()
+        );
         let s: f32 = row.iter().map(|(_, w)| w).sum();
         assert!((s - 1.0).abs() < 1e-5, "vertex {v}: sum {s}");
     }
@@ -38,11 +49,22 @@ fn weights_sum_to_one_with_at_most_eight_influences() {
 
 #[test]
 fn identity_pose_reproduces_the_rest_mesh() {
-    let body = model().shape(&Phenotype { gender: 0.0, weight: 0.8, ..Default::default() }).unwrap();
+    let body = model()
+        .shape(&Phenotype {
+            gender: 0.0,
+            weight: 0.8,
+            ..Default::default()
+        })
+        .unwrap();
     let pose = Pose::identity(body.rig.len());
     for method in [Skinning::Lbs, Skinning::Dqs] {
         let posed = body.posed(&pose, method).unwrap();
-        let err = posed.vertices.iter().zip(&body.mesh.vertices).map(|(a, b)| (*a - *b).length()).fold(0.0, f32::max);
+        let err = posed
+            .vertices
+            .iter()
+            .zip(&body.mesh.vertices)
+            .map(|(a, b)| (*a - *b).length())
+            .fold(0.0, f32::max);
         assert!(err < 1e-6, "{method:?}: {err}");
     }
 }
@@ -61,7 +83,10 @@ fn lbs_and_dqs_agree_away_from_joints_for_one_bone_rotation() {
         let row: Vec<_> = body.weights.row(v).collect();
         if row.len() == 1 {
             rigid += 1;
-            assert!((lbs.vertices[v] - dqs.vertices[v]).length() < 1e-5, "vertex {v}");
+            assert!(
+                (lbs.vertices[v] - dqs.vertices[v]).length() < 1e-5,
+                "vertex {v}"
+            );
         }
     }
     assert!(rigid > 1000);
@@ -94,7 +119,12 @@ fn posing_rejects_a_wrong_bone_count_and_nan() {
     pose.root_translation = Vec3::new(f32::NAN, 0.0, 0.0);
     let err = body.posed(&pose, Skinning::Dqs).unwrap_err().to_string();
     assert!(err.contains("NaN"), "{err}");
-    assert!(model().shape(&Phenotype { age: f32::NAN, ..Default::default() }).is_err());
+    assert!(model()
+        .shape(&Phenotype {
+            age: f32::NAN,
+            ..Default::default()
+        })
+        .is_err());
 }
 
 #[test]
@@ -103,19 +133,33 @@ fn random_shapes_are_realistic_adults_and_reproducible() {
     let mut statures = Vec::new();
     for seed in 0..12 {
         let s = dist.sample(model(), seed).unwrap();
-        assert!((1.45..=2.0).contains(&s.stature), "seed {seed}: stature {}", s.stature);
+        assert!(
+            (1.45..=2.0).contains(&s.stature),
+            "seed {seed}: stature {}",
+            s.stature
+        );
         assert!((16.0..=40.0).contains(&s.bmi), "seed {seed}: BMI {}", s.bmi);
-        assert!((s.stature - s.target_stature).abs() < 0.01, "seed {seed}: {s:?}");
+        assert!(
+            (s.stature - s.target_stature).abs() < 0.01,
+            "seed {seed}: {s:?}"
+        );
         // BMI is met, or the model's heaviest shape fell short of a high target.
         let saturated = s.phenotype.weight >= 1.0 && s.bmi < s.target_bmi;
-        assert!((s.bmi - s.target_bmi).abs() < 0.5 || saturated, "seed {seed}: {s:?}");
+        assert!(
+            (s.bmi - s.target_bmi).abs() < 0.5 || saturated,
+            "seed {seed}: {s:?}"
+        );
         let body = model().shape(&s.phenotype).unwrap();
         let (h, b) = stature_and_bmi(&body);
         assert!((h - s.stature).abs() < 1e-6 && (b - s.bmi).abs() < 1e-4);
         statures.push(s.stature);
     }
-    assert_eq!(dist.sample(model(), 3).unwrap(), dist.sample(model(), 3).unwrap());
-    let spread = statures.iter().cloned().fold(0.0, f32::max) - statures.iter().cloned().fold(9.0, f32::min);
+    assert_eq!(
+        dist.sample(model(), 3).unwrap(),
+        dist.sample(model(), 3).unwrap()
+    );
+    let spread =
+        statures.iter().cloned().fold(0.0, f32::max) - statures.iter().cloned().fold(9.0, f32::min);
     assert!(spread > 0.08, "shapes vary: spread {spread}");
 }
 
@@ -127,7 +171,13 @@ fn cmu_walk_frames_stand_upright_with_feet_on_the_floor_and_arms_at_the_sides() 
         return;
     }
     let clip = body::pose::Clip::from_asf_amc(dir.join("02.asf"), dir.join("02_01.amc")).unwrap();
-    let body = model().shape(&Phenotype { gender: 0.0, age: 0.7, ..Default::default() }).unwrap();
+    let body = model()
+        .shape(&Phenotype {
+            gender: 0.0,
+            age: 0.7,
+            ..Default::default()
+        })
+        .unwrap();
     let rig = &body.rig;
     let at = |joints: &[(Vec3, Vec3)], name: &str| joints[rig.index(name).unwrap()].0;
     for frame in [60, 120, 180, 240, 300] {
@@ -135,23 +185,47 @@ fn cmu_walk_frames_stand_upright_with_feet_on_the_floor_and_arms_at_the_sides() 
         let joints = rig.posed_joints(&pose);
         let (head, hips) = (at(&joints, "Head"), at(&joints, "Hips"));
         let feet = [at(&joints, "LeftFoot"), at(&joints, "RightFoot")];
-        assert!(head.y > hips.y + 0.4 && feet.iter().all(|f| f.y < hips.y - 0.6), "frame {frame} upright");
+        assert!(
+            head.y > hips.y + 0.4 && feet.iter().all(|f| f.y < hips.y - 0.6),
+            "frame {frame} upright"
+        );
         let up = (head - hips).normalize();
         assert!(up.y > 0.9, "frame {frame}: trunk leans {up}");
         let mesh = body.posed(&pose, Skinning::Dqs).unwrap();
-        let floor = mesh.vertices.iter().map(|p| p.y).fold(f32::INFINITY, f32::min);
-        assert!(floor.abs() < 0.05, "frame {frame}: lowest point at {floor} m");
-        // Each foot (ankle or toes: heels lift at toe-off) near the floor.
+        let floor = mesh
+            .vertices
+            .iter()
+            .map(|p| p.y)
+            .fold(f32::INFINITY, f32::min);
+        // The clip's own lowest joint rises 6 cm over its 343 frames (capture floor), so
+        // allow that much.
+        assert!(
+            (-0.02..0.08).contains(&floor),
+            "frame {frame}: lowest point at {floor} m"
+        );
+        // Each foot (ankle or toes: heels lift at toe-off) near the lowest point.
         for side in ["Left", "Right"] {
             let toe = joints[rig.index(&format!("{side}ToeBase")).unwrap()];
-            let low = at(&joints, &format!("{side}Foot")).y.min(toe.0.y).min(toe.1.y);
-            assert!(low < 0.15, "frame {frame}: {side} foot {low} m above the floor");
+            let low = at(&joints, &format!("{side}Foot"))
+                .y
+                .min(toe.0.y)
+                .min(toe.1.y);
+            assert!(
+                low - floor < 0.15,
+                "frame {frame}: {side} foot {low} m, floor {floor} m"
+            );
         }
         for (hand, shoulder) in [("LeftHand", "LeftArm"), ("RightHand", "RightArm")] {
             let (h, s) = (at(&joints, hand), at(&joints, shoulder));
-            assert!(h.y < s.y - 0.35, "frame {frame}: {hand} not below the shoulder");
+            assert!(
+                h.y < s.y - 0.35,
+                "frame {frame}: {hand} not below the shoulder"
+            );
             let off = (h - hips).with_y(0.0).length();
-            assert!(off < 0.4, "frame {frame}: {hand} {off} m away from the side, hips {hips}, hand {h}");
+            assert!(
+                off < 0.4,
+                "frame {frame}: {hand} {off} m away from the side, hips {hips}, hand {h}"
+            );
         }
     }
 }
@@ -159,14 +233,22 @@ fn cmu_walk_frames_stand_upright_with_feet_on_the_floor_and_arms_at_the_sides() 
 #[test]
 fn self_contact_flags_an_arm_through_the_torso_but_not_the_rest_pose() {
     use body::self_contact::SelfContact;
-    let body = model().shape(&Phenotype { weight: 0.9, ..Default::default() }).unwrap();
+    let body = model()
+        .shape(&Phenotype {
+            weight: 0.9,
+            ..Default::default()
+        })
+        .unwrap();
     let contact = SelfContact::new(&body);
     assert_eq!(contact.count_intersections(&body.mesh), 0, "rest pose");
     let rig = &body.rig;
     let arm = rig.index("LeftArm").unwrap();
     let (head, tail) = (rig.bones[arm].head, rig.bones[arm].tail);
     // Swing the left arm (and everything below it) across the chest.
-    let swing = Quat::from_rotation_arc((tail - head).normalize(), Vec3::new(-1.0, -0.1, 0.05).normalize());
+    let swing = Quat::from_rotation_arc(
+        (tail - head).normalize(),
+        Vec3::new(-1.0, -0.1, 0.05).normalize(),
+    );
     let mut world = vec![Quat::IDENTITY; rig.len()];
     let mut below = vec![false; rig.len()];
     for (b, bone) in rig.bones.iter().enumerate() {

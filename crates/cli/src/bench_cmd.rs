@@ -39,19 +39,29 @@ fn median_time<T>(repeat: usize, mut f: impl FnMut() -> T) -> Duration {
 
 fn bench_body(repeat: usize) -> anyhow::Result<()> {
     let cache = body::assets::ensure_body_cache()?;
-    let load = median_time(repeat.min(10), || BodyModel::from_file(&cache).expect("body file"));
+    let load = median_time(repeat.min(10), || {
+        BodyModel::from_file(&cache).expect("body file")
+    });
     let model = BodyModel::from_file(&cache)?;
-    let phenotype = Phenotype { gender: 0.2, weight: 0.7, ..Default::default() };
+    let phenotype = Phenotype {
+        gender: 0.2,
+        weight: 0.7,
+        ..Default::default()
+    };
     let shape = median_time(repeat, || model.shape(&phenotype).expect("shape"));
     let body = model.shape(&phenotype)?;
     // A non-trivial pose: the T-pose plus a bent elbow and knee.
     let mut pose: Pose = model.tpose();
     for (name, angle) in [("LeftForeArm", 1.0f32), ("RightLeg", -0.8)] {
-        let b = body.rig.index(name).ok_or_else(|| anyhow::anyhow!("rig has no {name}"))?;
+        let b = body
+            .rig
+            .index(name)
+            .ok_or_else(|| anyhow::anyhow!("rig has no {name}"))?;
         pose.rotations[b] *= glam::Quat::from_rotation_x(angle);
     }
     let one_core = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
-    let pose_time = |method: Skinning| median_time(repeat, || body.posed(&pose, method).expect("pose"));
+    let pose_time =
+        |method: Skinning| median_time(repeat, || body.posed(&pose, method).expect("pose"));
     let lbs_1 = one_core.install(|| pose_time(Skinning::Lbs));
     let dqs_1 = one_core.install(|| pose_time(Skinning::Dqs));
     let dqs_n = pose_time(Skinning::Dqs);
@@ -66,7 +76,10 @@ fn bench_body(repeat: usize) -> anyhow::Result<()> {
         ("forward kinematics (31 bones)", fk),
         ("pose LBS, 1 core (reference)", lbs_1),
         ("pose DQS, 1 core", dqs_1),
-        (&*format!("pose DQS, {} cores", rayon::current_num_threads()), dqs_n),
+        (
+            &*format!("pose DQS, {} cores", rayon::current_num_threads()),
+            dqs_n,
+        ),
     ];
     for (name, t) in rows {
         println!("| {name} | {:.3} | {:.2} |", ms(t), ms(t) / ms(lbs_1));
@@ -75,7 +88,11 @@ fn bench_body(repeat: usize) -> anyhow::Result<()> {
     println!(
         "DQS posing on one core: {:.3} ms ({} the {target} ms target)",
         ms(dqs_1),
-        if ms(dqs_1) < target { "meets" } else { "misses" }
+        if ms(dqs_1) < target {
+            "meets"
+        } else {
+            "misses"
+        }
     );
     Ok(())
 }

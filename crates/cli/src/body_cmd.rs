@@ -60,8 +60,14 @@ impl BodyArgs {
     /// pose, written to `out/body.glb` and `out/body.png`.
     pub fn main_job() -> Self {
         Self {
-            shape: ShapeArgs { random_shape: Some(1), ..ShapeArgs::defaults() },
-            pose: PoseArgs { pose_procedural: Some(1), ..PoseArgs::default() },
+            shape: ShapeArgs {
+                random_shape: Some(1),
+                ..ShapeArgs::defaults()
+            },
+            pose: PoseArgs {
+                pose_procedural: Some(1),
+                ..PoseArgs::default()
+            },
             skinning: SkinningArg::Dqs,
             out: "out/body.glb".into(),
             png: Some("out/body.png".into()),
@@ -80,7 +86,10 @@ pub fn run(args: &BodyArgs) -> anyhow::Result<()> {
     let body = model.shape(&phenotype)?;
     let (pose, what) = args.pose.pose(&model, &body)?;
     let mesh = body.posed(&pose, args.skinning.into())?;
-    eprintln!("body: {:.1} cm tall at rest, pose: {what}", body.height() * 100.0);
+    eprintln!(
+        "body: {:.1} cm tall at rest, pose: {what}",
+        body.height() * 100.0
+    );
     write_mesh(&args.out, &mesh)?;
     if let Some(png) = &args.png {
         write_png(png, &[(&mesh, palette::SKIN)], (480, 720))?;
@@ -90,51 +99,89 @@ pub fn run(args: &BodyArgs) -> anyhow::Result<()> {
 
 /// The five pose sources of the sheet, as pose arguments for shape `seed`.
 fn sheet_poses(mocap: &Path, bvh: &Path, seed: u64) -> [(PoseArgs, &'static str); 5] {
-    let amc = |clip: &str, frame| PoseArgs { pose_amc: Some(mocap.join(clip)), frame, ..PoseArgs::default() };
-    let procedural = |kind| PoseArgs { pose_procedural: Some(seed), pose_kind: kind, ..PoseArgs::default() };
+    let amc = |clip: &str, frame| PoseArgs {
+        pose_amc: Some(mocap.join(clip)),
+        frame,
+        ..PoseArgs::default()
+    };
+    let procedural = |kind| PoseArgs {
+        pose_procedural: Some(seed),
+        pose_kind: kind,
+        ..PoseArgs::default()
+    };
     [
-        (amc("02/02_01.amc", 90 + 10 * seed as usize), "AMC walk 02_01"),
-        (amc("01/01_02.amc", 1500 + 300 * seed as usize), "AMC climb 01_02"),
-        (PoseArgs { pose_bvh: Some(bvh.to_path_buf()), frame: 400 + 120 * seed as usize, ..PoseArgs::default() }, "BVH 02_05"),
-        (procedural(KindArg::Walk), "procedural walk"),
-        (procedural(KindArg::Yoga), "procedural yoga"),
+        (amc("02/02_01.amc", 90 + 10 * seed as usize), "AMC walk"),
+        (amc("01/01_02.amc", 1500 + 300 * seed as usize), "AMC climb"),
+        (
+            PoseArgs {
+                pose_bvh: Some(bvh.to_path_buf()),
+                frame: 400 + 120 * seed as usize,
+                ..PoseArgs::default()
+            },
+            "BVH punch",
+        ),
+        (procedural(KindArg::Walk), "proc. walk"),
+        (procedural(KindArg::Yoga), "proc. yoga"),
     ]
 }
 
 /// Five random shapes (seeds 1-5) in five poses each, front and side, one PNG.
-fn write_sheet(model: &BodyModel, path: &Path, mocap: &Path, skinning: Skinning) -> anyhow::Result<()> {
+fn write_sheet(
+    model: &BodyModel,
+    path: &Path,
+    mocap: &Path,
+    skinning: Skinning,
+) -> anyhow::Result<()> {
     // The BVH column reads a BVH file that garnet writes from a CMU clip.
     let tmp = tempfile::tempdir()?;
     let bvh = tmp.path().join("02_05.bvh");
-    let asf = Asf::read(mocap.join("02/02.asf")).context("--mocap must hold the CMU subjects 01 and 02")?;
+    let asf = Asf::read(mocap.join("02/02.asf"))
+        .context("--mocap must hold the CMU subjects 01 and 02")?;
     let amc = Amc::read(mocap.join("02/02_05.amc"), &asf)?;
     save_bvh(&bvh, &asf, &amc, &BvhWriteOptions::default())?;
 
     let cells: Vec<(u64, usize)> = (1..=5).flat_map(|s| (0..5).map(move |p| (s, p))).collect();
     let options = RenderOptions {
-        framing: Framing::Bounds { min: Vec3::new(-1.0, -0.05, -1.0), max: Vec3::new(1.0, 2.15, 1.0) },
+        framing: Framing::Bounds {
+            min: Vec3::new(-0.9, -0.05, -0.9),
+            max: Vec3::new(0.9, 2.05, 0.9),
+        },
         ..RenderOptions::default()
     };
     let images = cells
         .par_iter()
         .map(|&(seed, p)| -> anyhow::Result<(render::Image, String)> {
-            let shape = ShapeArgs { random_shape: Some(seed), ..ShapeArgs::defaults() };
+            let shape = ShapeArgs {
+                random_shape: Some(seed),
+                ..ShapeArgs::defaults()
+            };
             let body = model.shape(&shape.phenotype(model)?)?;
             let (pose_args, label) = &sheet_poses(mocap, &bvh, seed)[p];
             let (pose, what) = pose_args.pose(model, &body)?;
             let mesh = body.posed(&pose, skinning)?;
             let scene = [RenderMesh::new(&mesh.vertices, &mesh.faces, palette::SKIN)];
-            let image = render::render_views_with(&scene, &[View::Front, View::Side], (200, 300), &options)?;
+            let image = render::render_views_with(
+                &scene,
+                &[View::Front, View::Side],
+                (220, 330),
+                &options,
+            )?;
             let detail = what.rsplit(' ').next().unwrap_or("");
-            Ok((image, format!("shape {seed} ({:.0} cm): {label} #{detail}", body.height() * 100.0)))
+            Ok((
+                image,
+                format!("{seed}: {:.0} cm, {label} #{detail}", body.height() * 100.0),
+            ))
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
-    let mut sheet = Sheet::new(5).with_title("garnet body: 5 random adult shapes x 5 pose sources (front | side)");
+    let mut sheet = Sheet::new(5)
+        .with_title("garnet body: 5 random adult shapes x 5 pose sources (front | side)");
     for (image, caption) in images {
         sheet.push(image, caption);
     }
     create_parent(path)?;
-    sheet.save_png(path).with_context(|| format!("writing {}", path.display()))?;
+    sheet
+        .save_png(path)
+        .with_context(|| format!("writing {}", path.display()))?;
     eprintln!("wrote {}", path.display());
     Ok(())
 }

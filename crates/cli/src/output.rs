@@ -16,18 +16,34 @@ pub fn write_mesh(path: &Path, mesh: &TriMesh) -> anyhow::Result<()> {
 
 /// Renders the front and side views of `meshes` (`(mesh, colour)`) at `size` pixels
 /// per view and saves a PNG.
-pub fn write_png(path: &Path, meshes: &[(&TriMesh, [u8; 3])], size: (u32, u32)) -> anyhow::Result<()> {
+pub fn write_png(
+    path: &Path,
+    meshes: &[(&TriMesh, [u8; 3])],
+    size: (u32, u32),
+) -> anyhow::Result<()> {
     create_parent(path)?;
     let image = render_views(meshes, size)?;
-    image.save_png(path).with_context(|| format!("writing {}", path.display()))?;
+    image
+        .save_png(path)
+        .with_context(|| format!("writing {}", path.display()))?;
     eprintln!("wrote {}", path.display());
     Ok(())
 }
 
 /// Front and side views of `meshes` side by side.
-pub fn render_views(meshes: &[(&TriMesh, [u8; 3])], size: (u32, u32)) -> anyhow::Result<render::Image> {
-    let scene: Vec<RenderMesh> = meshes.iter().map(|(m, c)| RenderMesh::new(&m.vertices, &m.faces, *c)).collect();
-    Ok(render::render_views(&scene, &[View::Front, View::Side], size)?)
+pub fn render_views(
+    meshes: &[(&TriMesh, [u8; 3])],
+    size: (u32, u32),
+) -> anyhow::Result<render::Image> {
+    let scene: Vec<RenderMesh> = meshes
+        .iter()
+        .map(|(m, c)| RenderMesh::new(&m.vertices, &m.faces, *c))
+        .collect();
+    Ok(render::render_views(
+        &scene,
+        &[View::Front, View::Side],
+        size,
+    )?)
 }
 
 /// Creates the parent directory of `path` if it is missing.

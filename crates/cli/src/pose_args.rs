@@ -62,7 +62,11 @@ pub fn default_asf(amc: &Path) -> anyhow::Result<PathBuf> {
     let subject = stem.split('_').next().unwrap_or(stem);
     let asf = amc.with_file_name(format!("{subject}.asf"));
     if !asf.is_file() {
-        bail!("{}: no skeleton {} beside the clip; give it with --asf", amc.display(), asf.display());
+        bail!(
+            "{}: no skeleton {} beside the clip; give it with --asf",
+            amc.display(),
+            asf.display()
+        );
     }
     Ok(asf)
 }
@@ -92,7 +96,10 @@ impl PoseArgs {
             let mut generator = ProceduralPoseGenerator::new(seed, self.pose_kind.into());
             let pose = sample_valid_pose(body, &mut generator, 200)
                 .with_context(|| format!("procedural pose, seed {seed}"))?;
-            return Ok((pose, format!("procedural {:?} {seed}", self.pose_kind).to_lowercase()));
+            return Ok((
+                pose,
+                format!("procedural {:?} {seed}", self.pose_kind).to_lowercase(),
+            ));
         }
         Ok((Pose::identity(body.rig.len()), "rest A-pose".into()))
     }
@@ -100,5 +107,8 @@ impl PoseArgs {
 
 /// The file name of `path` for captions.
 pub fn file_name(path: &Path) -> String {
-    path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned())
+    path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
 }

@@ -4,7 +4,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn garnet(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_garnet")).args(args).output().expect("garnet runs")
+    Command::new(env!("CARGO_BIN_EXE_garnet"))
+        .args(args)
+        .output()
+        .expect("garnet runs")
 }
 
 fn ok(args: &[&str]) -> String {
@@ -34,7 +37,10 @@ fn s(p: &Path) -> &str {
 #[test]
 fn assets_path_reports_the_body_file() {
     let out = ok(&["assets", "path"]);
-    assert!(out.contains("body-v1.safetensors") && out.contains("31 bones"), "{out}");
+    assert!(
+        out.contains("body-v1.safetensors") && out.contains("31 bones"),
+        "{out}"
+    );
 }
 
 #[test]
@@ -42,14 +48,33 @@ fn body_writes_mesh_and_picture() {
     let dir = tempfile::tempdir().unwrap();
     let obj = dir.path().join("t.obj");
     let png = dir.path().join("t.png");
-    ok(&["body", "--tpose", "--gender", "1", "--out", s(&obj), "--png", s(&png)]);
+    ok(&[
+        "body",
+        "--tpose",
+        "--gender",
+        "1",
+        "--out",
+        s(&obj),
+        "--png",
+        s(&png),
+    ]);
     let mesh = geom::io::read_mesh(&obj).unwrap();
     assert_eq!(mesh.vertices.len(), 13380);
     let image = render::Image::from_png(&png).unwrap();
     assert!(image.width >= 400 && image.count_not(image.pixel(0, 0)) > 10_000);
     for ext in ["ply", "glb"] {
         let p = dir.path().join(format!("r.{ext}"));
-        ok(&["body", "--random-shape", "4", "--pose-procedural", "2", "--pose-kind", "dance", "--out", s(&p)]);
+        ok(&[
+            "body",
+            "--random-shape",
+            "4",
+            "--pose-procedural",
+            "2",
+            "--pose-kind",
+            "dance",
+            "--out",
+            s(&p),
+        ]);
         assert_eq!(geom::io::read_mesh(&p).unwrap().faces.len(), 26756);
     }
 }
@@ -61,11 +86,20 @@ fn body_refuses_bad_parameters_and_files() {
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("bad.bvh");
     std::fs::write(&bad, "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0\n").unwrap();
-    let err = fails(&["body", "--pose-bvh", s(&bad), "--out", s(&dir.path().join("x.obj"))]);
+    let err = fails(&[
+        "body",
+        "--pose-bvh",
+        s(&bad),
+        "--out",
+        s(&dir.path().join("x.obj")),
+    ]);
     assert!(err.contains("bad.bvh"), "{err}");
     let err = fails(&["body", "--pose-amc", s(&dir.path().join("missing_01.amc"))]);
     assert!(err.contains("missing_01.amc"), "{err}");
-    assert!(!dir.path().join("x.obj").exists(), "nothing written on error");
+    assert!(
+        !dir.path().join("x.obj").exists(),
+        "nothing written on error"
+    );
 }
 
 #[test]
@@ -77,14 +111,47 @@ fn pose_convert_then_body_from_bvh_and_amc() {
     let dir = tempfile::tempdir().unwrap();
     let bvh = dir.path().join("walk.bvh");
     let (asf, amc) = (mocap.join("02/02.asf"), mocap.join("02/02_01.amc"));
-    ok(&["pose", "convert", "--asf", s(&asf), "--amc", s(&amc), "--out", s(&bvh)]);
+    ok(&[
+        "pose",
+        "convert",
+        "--asf",
+        s(&asf),
+        "--amc",
+        s(&amc),
+        "--out",
+        s(&bvh),
+    ]);
     let from_bvh = dir.path().join("b.obj");
     let from_amc = dir.path().join("a.obj");
-    ok(&["body", "--pose-bvh", s(&bvh), "--frame", "100", "--out", s(&from_bvh)]);
-    ok(&["body", "--pose-amc", s(&amc), "--frame", "100", "--out", s(&from_amc)]);
+    ok(&[
+        "body",
+        "--pose-bvh",
+        s(&bvh),
+        "--frame",
+        "100",
+        "--out",
+        s(&from_bvh),
+    ]);
+    ok(&[
+        "body",
+        "--pose-amc",
+        s(&amc),
+        "--frame",
+        "100",
+        "--out",
+        s(&from_amc),
+    ]);
     // The BVH written from the clip poses the body as the clip itself does.
-    let (a, b) = (geom::io::read_mesh(&from_amc).unwrap(), geom::io::read_mesh(&from_bvh).unwrap());
-    let worst = a.vertices.iter().zip(&b.vertices).map(|(p, q)| (*p - *q).length()).fold(0.0, f32::max);
+    let (a, b) = (
+        geom::io::read_mesh(&from_amc).unwrap(),
+        geom::io::read_mesh(&from_bvh).unwrap(),
+    );
+    let worst = a
+        .vertices
+        .iter()
+        .zip(&b.vertices)
+        .map(|(p, q)| (*p - *q).length())
+        .fold(0.0, f32::max);
     assert!(worst < 2e-3, "AMC and BVH poses differ by {worst} m");
     let err = fails(&["body", "--pose-amc", s(&amc), "--frame", "999999"]);
     assert!(err.contains("frame"), "{err}");
@@ -106,7 +173,10 @@ fn body_sheet_renders_five_shapes_in_five_poses() {
 #[test]
 fn bench_body_reports_ratios() {
     let out = ok(&["bench", "body", "--repeat", "3"]);
-    assert!(out.contains("pose DQS, 1 core") && out.contains("ratio"), "{out}");
+    assert!(
+        out.contains("pose DQS, 1 core") && out.contains("ratio"),
+        "{out}"
+    );
 }
 
 #[test]
@@ -114,7 +184,9 @@ fn missing_pip_or_bad_assets_folder_give_clear_errors() {
     let home = tempfile::tempdir().unwrap();
     let run = |envs: &[(&str, &str)]| {
         let mut cmd = Command::new(env!("CARGO_BIN_EXE_garnet"));
-        cmd.args(["assets", "fetch"]).env("GARNET_HOME", home.path()).env_remove("GARNET_ASSETS");
+        cmd.args(["assets", "fetch"])
+            .env("GARNET_HOME", home.path())
+            .env_remove("GARNET_ASSETS");
         for (k, v) in envs {
             cmd.env(k, v);
         }
@@ -125,6 +197,9 @@ fn missing_pip_or_bad_assets_folder_give_clear_errors() {
     let err = run(&[("PATH", "")]);
     assert!(err.contains("no python3, pip3 or pip"), "{err}");
     let err = run(&[("GARNET_ASSETS", "/nonexistent/mpfb2")]);
-    assert!(err.contains("/nonexistent/mpfb2") && err.contains("GARNET_ASSETS"), "{err}");
+    assert!(
+        err.contains("/nonexistent/mpfb2") && err.contains("GARNET_ASSETS"),
+        "{err}"
+    );
     assert!(!home.path().join("body-v1.safetensors").exists());
 }

@@ -56,13 +56,19 @@ pub fn convert_assets(mpfb2: &Path, out: &Path) -> Result<(), BodyError> {
         })
         .collect();
     if kept.len() > u16::MAX as usize {
-        return Err(BodyError::asset(mpfb2, "too many vertices for 16-bit target indices"));
+        return Err(BodyError::asset(
+            mpfb2,
+            "too many vertices for 16-bit target indices",
+        ));
     }
 
     let mut faces: Vec<u32> = Vec::new();
     for poly in &base.body_faces {
         if poly.iter().any(|&i| i as usize >= BODY_VERTEX_COUNT) {
-            return Err(BodyError::asset(mpfb2.join("3dobjs/base.obj"), "body face uses a non-body vertex"));
+            return Err(BodyError::asset(
+                mpfb2.join("3dobjs/base.obj"),
+                "body face uses a non-body vertex",
+            ));
         }
         for k in 1..poly.len() - 1 {
             faces.extend([poly[0], poly[k], poly[k + 1]]);
@@ -70,9 +76,18 @@ pub fn convert_assets(mpfb2: &Path, out: &Path) -> Result<(), BodyError> {
     }
 
     let mut tensors: BTreeMap<String, (Dtype, Vec<usize>, Vec<u8>)> = BTreeMap::new();
-    let vertices: Vec<f32> = kept.iter().flat_map(|&i| base.vertices[i as usize]).collect();
-    tensors.insert("vertices".into(), (Dtype::F32, vec![kept.len(), 3], le(&vertices)));
-    tensors.insert("faces".into(), (Dtype::U32, vec![faces.len() / 3, 3], le(&faces)));
+    let vertices: Vec<f32> = kept
+        .iter()
+        .flat_map(|&i| base.vertices[i as usize])
+        .collect();
+    tensors.insert(
+        "vertices".into(),
+        (Dtype::F32, vec![kept.len(), 3], le(&vertices)),
+    );
+    tensors.insert(
+        "faces".into(),
+        (Dtype::U32, vec![faces.len() / 3, 3], le(&faces)),
+    );
     let (mut offsets, mut wb, mut wv) = (vec![0u32], Vec::<u16>::new(), Vec::<f32>::new());
     for row in &weight_rows {
         let total: f32 = row.iter().map(|(_, w)| w).sum();
@@ -82,17 +97,32 @@ pub fn convert_assets(mpfb2: &Path, out: &Path) -> Result<(), BodyError> {
         }
         offsets.push(wb.len() as u32);
     }
-    tensors.insert("weights.offsets".into(), (Dtype::U32, vec![offsets.len()], le(&offsets)));
-    tensors.insert("weights.bones".into(), (Dtype::U16, vec![wb.len()], le(&wb)));
-    tensors.insert("weights.values".into(), (Dtype::F32, vec![wv.len()], le(&wv)));
+    tensors.insert(
+        "weights.offsets".into(),
+        (Dtype::U32, vec![offsets.len()], le(&offsets)),
+    );
+    tensors.insert(
+        "weights.bones".into(),
+        (Dtype::U16, vec![wb.len()], le(&wb)),
+    );
+    tensors.insert(
+        "weights.values".into(),
+        (Dtype::F32, vec![wv.len()], le(&wv)),
+    );
     let mut reg_off = vec![0u32];
     let mut reg_idx: Vec<u32> = Vec::new();
     for r in &regressors {
         reg_idx.extend(r);
         reg_off.push(reg_idx.len() as u32);
     }
-    tensors.insert("regressors.offsets".into(), (Dtype::U32, vec![reg_off.len()], le(&reg_off)));
-    tensors.insert("regressors.indices".into(), (Dtype::U32, vec![reg_idx.len()], le(&reg_idx)));
+    tensors.insert(
+        "regressors.offsets".into(),
+        (Dtype::U32, vec![reg_off.len()], le(&reg_off)),
+    );
+    tensors.insert(
+        "regressors.indices".into(),
+        (Dtype::U32, vec![reg_idx.len()], le(&reg_idx)),
+    );
 
     for dir in TARGET_DIRS {
         let dir_path = mpfb2.join("targets").join(dir);
@@ -103,28 +133,52 @@ pub fn convert_assets(mpfb2: &Path, out: &Path) -> Result<(), BodyError> {
             .collect();
         names.sort();
         for path in names {
-            let name = path.file_name().unwrap().to_string_lossy().trim_end_matches(".target.gz").to_string();
+            let name = path
+                .file_name()
+                .unwrap()
+                .to_string_lossy()
+                .trim_end_matches(".target.gz")
+                .to_string();
             let (index, delta) = read_target(&path, &remap)?;
-            tensors.insert(format!("target/{name}/index"), (Dtype::U16, vec![index.len()], le(&index)));
-            tensors.insert(format!("target/{name}/delta"), (Dtype::I16, vec![index.len(), 3], le(&delta)));
+            tensors.insert(
+                format!("target/{name}/index"),
+                (Dtype::U16, vec![index.len()], le(&index)),
+            );
+            tensors.insert(
+                format!("target/{name}/delta"),
+                (Dtype::I16, vec![index.len(), 3], le(&delta)),
+            );
         }
     }
 
     let views: Vec<(String, TensorView<'_>)> = tensors
         .iter()
-        .map(|(k, (d, s, b))| (k.clone(), TensorView::new(*d, s.clone(), b).expect("consistent tensor")))
+        .map(|(k, (d, s, b))| {
+            (
+                k.clone(),
+                TensorView::new(*d, s.clone(), b).expect("consistent tensor"),
+            )
+        })
         .collect();
     let meta: HashMap<String, String> = HashMap::from([
         ("format".to_string(), FORMAT.to_string()),
         ("source_sha256".to_string(), WHEEL_SHA256.to_string()),
-        ("bones".to_string(), serde_json::to_string(&bones).expect("bones serialise")),
-        ("tpose".to_string(), serde_json::to_string(&tpose).expect("tpose serialises")),
+        (
+            "bones".to_string(),
+            serde_json::to_string(&bones).expect("bones serialise"),
+        ),
+        (
+            "tpose".to_string(),
+            serde_json::to_string(&tpose).expect("tpose serialises"),
+        ),
     ]);
-    let bytes = safetensors::serialize(views, Some(meta)).map_err(|e| BodyError::asset(out, e.to_string()))?;
+    let bytes = safetensors::serialize(views, Some(meta))
+        .map_err(|e| BodyError::asset(out, e.to_string()))?;
     if let Some(dir) = out.parent() {
         std::fs::create_dir_all(dir).map_err(|e| BodyError::asset(dir, e.to_string()))?;
     }
-    geom::io::write_atomic(out, |w| w.write_all(&bytes)).map_err(|e| BodyError::asset(out, e.to_string()))
+    geom::io::write_atomic(out, |w| w.write_all(&bytes))
+        .map_err(|e| BodyError::asset(out, e.to_string()))
 }
 
 /// Little-endian bytes of a slice of plain numbers.
@@ -151,7 +205,10 @@ fn read_base_obj(path: &Path) -> Result<BaseObj, BodyError> {
         let mut it = line.split_whitespace();
         match it.next() {
             Some("v") => {
-                let c: Vec<f32> = it.map(str::parse).collect::<Result<_, _>>().map_err(|_| bad("bad vertex"))?;
+                let c: Vec<f32> = it
+                    .map(str::parse)
+                    .collect::<Result<_, _>>()
+                    .map_err(|_| bad("bad vertex"))?;
                 if c.len() != 3 || c.iter().any(|x| !x.is_finite()) {
                     return Err(bad("vertex needs three finite coordinates"));
                 }
@@ -160,7 +217,15 @@ fn read_base_obj(path: &Path) -> Result<BaseObj, BodyError> {
             Some("g") => group = it.next().unwrap_or("").to_string(),
             Some("f") => {
                 let poly: Vec<u32> = it
-                    .map(|t| t.split('/').next().unwrap_or("").parse::<u32>().ok().filter(|&i| i >= 1).map(|i| i - 1))
+                    .map(|t| {
+                        t.split('/')
+                            .next()
+                            .unwrap_or("")
+                            .parse::<u32>()
+                            .ok()
+                            .filter(|&i| i >= 1)
+                            .map(|i| i - 1)
+                    })
                     .collect::<Option<_>>()
                     .ok_or_else(|| bad("bad face index"))?;
                 if poly.len() < 3 || poly.iter().any(|&i| i as usize >= vertices.len()) {
@@ -179,11 +244,20 @@ fn read_base_obj(path: &Path) -> Result<BaseObj, BodyError> {
             _ => {}
         }
     }
-    let body = groups.get("body").ok_or_else(|| BodyError::asset(path, "no body group"))?;
+    let body = groups
+        .get("body")
+        .ok_or_else(|| BodyError::asset(path, "no body group"))?;
     if body.len() != BODY_VERTEX_COUNT || body.iter().any(|&i| i as usize >= BODY_VERTEX_COUNT) {
-        return Err(BodyError::asset(path, format!("body group must use vertices 0..{BODY_VERTEX_COUNT}")));
+        return Err(BodyError::asset(
+            path,
+            format!("body group must use vertices 0..{BODY_VERTEX_COUNT}"),
+        ));
     }
-    Ok(BaseObj { vertices, body_faces, groups })
+    Ok(BaseObj {
+        vertices,
+        body_faces,
+        groups,
+    })
 }
 
 /// Bone definitions in parent-before-child order and the vertex lists averaged for each
@@ -191,18 +265,37 @@ fn read_base_obj(path: &Path) -> Result<BaseObj, BodyError> {
 fn read_rig(path: &Path, base: &BaseObj) -> Result<(Vec<BoneDef>, Vec<Vec<u32>>), BodyError> {
     let bad = |m: String| BodyError::asset(path, m);
     let json = read_json(path)?;
-    let rig = json.as_object().ok_or_else(|| bad("not a JSON object".into()))?;
-    let parent_of = |name: &str| rig[name].get("parent").and_then(Value::as_str).unwrap_or("").to_string();
+    let rig = json
+        .as_object()
+        .ok_or_else(|| bad("not a JSON object".into()))?;
+    let parent_of = |name: &str| {
+        rig[name]
+            .get("parent")
+            .and_then(Value::as_str)
+            .unwrap_or("")
+            .to_string()
+    };
     // Depth-first from the root so that parents precede children; children by name.
     let mut names: Vec<&String> = rig.keys().collect();
     names.sort();
     let mut order: Vec<String> = Vec::new();
-    let mut stack: Vec<String> = names.iter().filter(|n| parent_of(n).is_empty()).map(|n| n.to_string()).collect();
+    let mut stack: Vec<String> = names
+        .iter()
+        .filter(|n| parent_of(n).is_empty())
+        .map(|n| n.to_string())
+        .collect();
     if stack.len() != 1 {
-        return Err(bad(format!("expected one root bone, found {}", stack.len())));
+        return Err(bad(format!(
+            "expected one root bone, found {}",
+            stack.len()
+        )));
     }
     while let Some(n) = stack.pop() {
-        let mut kids: Vec<String> = names.iter().filter(|k| parent_of(k) == n).map(|k| k.to_string()).collect();
+        let mut kids: Vec<String> = names
+            .iter()
+            .filter(|k| parent_of(k) == n)
+            .map(|k| k.to_string())
+            .collect();
         kids.reverse();
         order.push(n);
         stack.extend(kids);
@@ -214,26 +307,50 @@ fn read_rig(path: &Path, base: &BaseObj) -> Result<(Vec<BoneDef>, Vec<Vec<u32>>)
     let mut regressors = Vec::new();
     for name in &order {
         let def = &rig[name];
-        let parent = Some(parent_of(name)).filter(|p| !p.is_empty()).map(|p| order.iter().position(|o| *o == p).unwrap());
-        let roll = def.get("roll").and_then(Value::as_f64).ok_or_else(|| bad(format!("{name}: no roll")))? as f32;
+        let parent = Some(parent_of(name))
+            .filter(|p| !p.is_empty())
+            .map(|p| order.iter().position(|o| *o == p).unwrap());
+        let roll = def
+            .get("roll")
+            .and_then(Value::as_f64)
+            .ok_or_else(|| bad(format!("{name}: no roll")))? as f32;
         for end in ["head", "tail"] {
-            let e = def.get(end).ok_or_else(|| bad(format!("{name}: no {end}")))?;
+            let e = def
+                .get(end)
+                .ok_or_else(|| bad(format!("{name}: no {end}")))?;
             regressors.push(regressor(e, base).map_err(|m| bad(format!("{name} {end}: {m}")))?);
         }
-        bones.push(BoneDef { name: name.clone(), parent, roll });
+        bones.push(BoneDef {
+            name: name.clone(),
+            parent,
+            roll,
+        });
     }
     Ok((bones, regressors))
 }
 
 /// The vertices whose mean places a joint: a joint cube's vertices, one vertex, or a list.
 fn regressor(e: &Value, base: &BaseObj) -> Result<Vec<u32>, String> {
-    let idx = |v: &Value| v.as_u64().map(|i| i as u32).filter(|&i| (i as usize) < base.vertices.len());
+    let idx = |v: &Value| {
+        v.as_u64()
+            .map(|i| i as u32)
+            .filter(|&i| (i as usize) < base.vertices.len())
+    };
     let out = match e.get("strategy").and_then(Value::as_str) {
         Some("CUBE") => {
-            let cube = e.get("cube_name").and_then(Value::as_str).ok_or("CUBE without cube_name")?;
-            base.groups.get(cube).cloned().ok_or(format!("no group {cube} in base.obj"))?
+            let cube = e
+                .get("cube_name")
+                .and_then(Value::as_str)
+                .ok_or("CUBE without cube_name")?;
+            base.groups
+                .get(cube)
+                .cloned()
+                .ok_or(format!("no group {cube} in base.obj"))?
         }
-        Some("VERTEX") => vec![e.get("vertex_index").and_then(idx).ok_or("bad vertex_index")?],
+        Some("VERTEX") => vec![e
+            .get("vertex_index")
+            .and_then(idx)
+            .ok_or("bad vertex_index")?],
         Some("MEAN") => e
             .get("vertex_indices")
             .and_then(Value::as_array)
@@ -254,12 +371,24 @@ fn regressor(e: &Value, base: &BaseObj) -> Result<Vec<u32>, String> {
 fn read_weights(path: &Path, bones: &[BoneDef]) -> Result<Vec<Vec<(u16, f32)>>, BodyError> {
     let bad = |m: String| BodyError::asset(path, m);
     let json = read_json(path)?;
-    let table = json.get("weights").and_then(Value::as_object).ok_or_else(|| bad("no weights object".into()))?;
+    let table = json
+        .get("weights")
+        .and_then(Value::as_object)
+        .ok_or_else(|| bad("no weights object".into()))?;
     let mut rows = vec![Vec::new(); BODY_VERTEX_COUNT];
     for (bone, list) in table {
-        let b = bones.iter().position(|d| d.name == *bone).ok_or_else(|| bad(format!("unknown bone {bone}")))?;
-        for pair in list.as_array().ok_or_else(|| bad(format!("{bone}: not a list")))? {
-            let (v, w) = (pair.get(0).and_then(Value::as_u64), pair.get(1).and_then(Value::as_f64));
+        let b = bones
+            .iter()
+            .position(|d| d.name == *bone)
+            .ok_or_else(|| bad(format!("unknown bone {bone}")))?;
+        for pair in list
+            .as_array()
+            .ok_or_else(|| bad(format!("{bone}: not a list")))?
+        {
+            let (v, w) = (
+                pair.get(0).and_then(Value::as_u64),
+                pair.get(1).and_then(Value::as_f64),
+            );
             let (Some(v), Some(w)) = (v, w) else {
                 return Err(bad(format!("{bone}: bad [vertex, weight] pair")));
             };
@@ -282,10 +411,19 @@ fn read_tpose(path: &Path, bones: &[BoneDef]) -> Result<BTreeMap<String, [f32; 3
         .ok_or_else(|| BodyError::asset(path, "no bone_rotations"))?;
     rot.iter()
         .map(|(name, e)| {
-            let v: Option<Vec<f32>> = e.as_array().map(|a| a.iter().filter_map(|x| x.as_f64().map(|x| x as f32)).collect());
+            let v: Option<Vec<f32>> = e.as_array().map(|a| {
+                a.iter()
+                    .filter_map(|x| x.as_f64().map(|x| x as f32))
+                    .collect()
+            });
             match v {
-                Some(v) if v.len() == 3 && bones.iter().any(|b| b.name == *name) => Ok((name.clone(), [v[0], v[1], v[2]])),
-                _ => Err(BodyError::asset(path, format!("bad rotation for bone {name}"))),
+                Some(v) if v.len() == 3 && bones.iter().any(|b| b.name == *name) => {
+                    Ok((name.clone(), [v[0], v[1], v[2]]))
+                }
+                _ => Err(BodyError::asset(
+                    path,
+                    format!("bad rotation for bone {name}"),
+                )),
             }
         })
         .collect()
@@ -299,9 +437,11 @@ fn read_json(path: &Path) -> Result<Value, BodyError> {
 /// A target file's entries for kept vertices: new indices and offsets in 0.1 mm.
 fn read_target(path: &Path, remap: &HashMap<u32, u32>) -> Result<(Vec<u16>, Vec<i16>), BodyError> {
     let mut text = String::new();
-    flate2::read::GzDecoder::new(std::fs::File::open(path).map_err(|e| BodyError::asset(path, e.to_string()))?)
-        .read_to_string(&mut text)
-        .map_err(|e| BodyError::asset(path, format!("not a gzip text file: {e}")))?;
+    flate2::read::GzDecoder::new(
+        std::fs::File::open(path).map_err(|e| BodyError::asset(path, e.to_string()))?,
+    )
+    .read_to_string(&mut text)
+    .map_err(|e| BodyError::asset(path, format!("not a gzip text file: {e}")))?;
     let mut index = Vec::new();
     let mut delta = Vec::new();
     for (n, line) in text.lines().enumerate() {
@@ -312,7 +452,10 @@ fn read_target(path: &Path, remap: &HashMap<u32, u32>) -> Result<(Vec<u16>, Vec<
         }
         let bad = || BodyError::asset(path, format!("line {}: expected `index dx dy dz`", n + 1));
         let i: u32 = first.parse().map_err(|_| bad())?;
-        let d: Vec<f32> = it.map(str::parse).collect::<Result<_, _>>().map_err(|_| bad())?;
+        let d: Vec<f32> = it
+            .map(str::parse)
+            .collect::<Result<_, _>>()
+            .map_err(|_| bad())?;
         if d.len() != 3 {
             return Err(bad());
         }
@@ -322,7 +465,10 @@ fn read_target(path: &Path, remap: &HashMap<u32, u32>) -> Result<(Vec<u16>, Vec<
             // Decimetres with three decimals -> tenths of a millimetre, exactly.
             let q = (x * 1000.0).round();
             if !(i16::MIN as f32..=i16::MAX as f32).contains(&q) {
-                return Err(BodyError::asset(path, format!("line {}: offset {x} dm too large", n + 1)));
+                return Err(BodyError::asset(
+                    path,
+                    format!("line {}: offset {x} dm too large", n + 1),
+                ));
             }
             delta.push(q as i16);
         }

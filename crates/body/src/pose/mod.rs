@@ -7,7 +7,9 @@
 mod amc;
 mod asf;
 mod asf_fk;
+mod asf_parse;
 mod bvh;
+mod bvh_parse;
 mod bvh_write;
 pub mod cmu;
 mod error;

@@ -6,6 +6,13 @@
 //! direction, `O_b` the smallest rotation taking `d_b` to `a_s`, and the rig bone's world
 //! delta is `D_b = G_s * O_b`, so that `D_b d_b = G_s a_s`. The root takes `G_root`
 //! directly; rig bones without a source bone follow their parent.
+//!
+//! The clavicles and the pelvic hip bones are the exception: their rest directions
+//! reflect where a marker set or a skeleton author put the joints, not a posture (a CMU
+//! clavicle points 10-20 degrees higher than the body's), so matching them would shrug
+//! the shoulders. They take the source's rotation from its rest, `D_b = G_s`, keeping
+//! the body's own shoulder and pelvis geometry; the bones they carry still take the
+//! source's world directions.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -57,11 +64,16 @@ pub fn retarget_rotations(
         .get(skeleton.root)
         .copied()
         .unwrap_or(DQuat::IDENTITY);
+    const KEEP_REST_GEOMETRY: [&str; 4] =
+        ["LeftShoulder", "RightShoulder", "LHipJoint", "RHipJoint"];
     let mut deltas: Vec<Quat> = Vec::with_capacity(rig.len());
     for bone in &rig.bones {
         let source = by_name.get(bone.name.as_str()).copied();
         let d = match (bone.parent, source) {
             (None, s) => s.map_or(root_g, |s| frame.world[s]),
+            (Some(_), Some(s)) if KEEP_REST_GEOMETRY.contains(&bone.name.as_str()) => {
+                frame.world[s]
+            }
             (Some(_), Some(s)) => {
                 let a = skeleton.rest_vectors[s];
                 let d = (bone.tail - bone.head).as_dvec3();
@@ -104,7 +116,8 @@ pub fn rig_leg_length(rig: &Rig) -> f32 {
 
 /// The rig's root translation for a source frame: the source root position scaled by the
 /// ratio of leg lengths, its height taken relative to the source's standing rest root
-/// height (so a standing source keeps the rig's feet on its floor), horizontal motion
+/// height, plus the lift that puts the rig's feet on its floor when it takes the source's
+/// rest pose (so a standing source keeps the rig standing on y = 0); horizontal motion
 /// kept only if asked.
 pub fn retarget_translation(
     rig: &Rig,
@@ -118,13 +131,43 @@ pub fn retarget_translation(
         1.0
     };
     let p = frame.root_position;
-    let y = scale * (p.y - skeleton.rest_root_height);
+    let y = scale * (p.y - skeleton.rest_root_height) + rest_pose_lift(rig, skeleton) as f64;
     let t = if opts.keep_horizontal_translation {
         DVec3::new(scale * p.x, y, scale * p.z)
     } else {
         DVec3::new(0.0, y, 0.0)
     };
     t.as_vec3()
+}
+
+/// Lowest point of the feet (ankles, toe joints) of `rig` in `pose`, metres.
+fn lowest_foot_point(rig: &Rig, pose: &Pose) -> Option<f32> {
+    let joints = rig.posed_joints(pose);
+    ["LeftFoot", "RightFoot", "LeftToeBase", "RightToeBase"]
+        .iter()
+        .filter_map(|n| rig.index(n))
+        .flat_map(|i| [joints[i].0.y, joints[i].1.y])
+        .reduce(f32::min)
+}
+
+/// How far the rig's root must rise, when the rig takes the source's rest pose with no
+/// translation, for its feet to stand as low as in the rig's own rest pose (metres).
+fn rest_pose_lift(rig: &Rig, skeleton: &SourceSkeleton) -> f32 {
+    let rest_frame = SourceFrame {
+        world: vec![DQuat::IDENTITY; skeleton.names.len()],
+        root_position: DVec3::ZERO,
+    };
+    let Ok(deltas) = retarget_rotations(rig, skeleton, &rest_frame) else {
+        return 0.0;
+    };
+    let posed = Pose::from_world_rotations(rig, &deltas, Vec3::ZERO);
+    match (
+        lowest_foot_point(rig, &Pose::identity(rig.len())),
+        lowest_foot_point(rig, &posed),
+    ) {
+        (Some(rest), Some(posed)) => rest - posed,
+        _ => 0.0,
+    }
 }
 
 /// Retargets one source frame onto `rig`.

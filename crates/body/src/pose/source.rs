@@ -110,10 +110,7 @@ impl SourceSkeleton {
                 v * s
             })
             .collect();
-        let (world, pos) = match bvh.pose(None) {
-            Ok(p) => p,
-            Err(_) => (Vec::new(), Vec::new()),
-        };
+        let (world, pos) = bvh.pose(None).unwrap_or_default();
         let ends = bvh.end_sites(&world, &pos);
         let root_y = pos.first().map_or(0.0, |p| p.y);
         let lowest = pos.iter().chain(&ends).map(|p| p.y).fold(root_y, f64::min);

@@ -167,7 +167,9 @@ fn written_bvh_reproduces_the_asf_clip() {
             assert!((*t - ends[i].1).length() < 1e-6);
         }
     }
-    let mut opts = BvhWriteOptions::default();
-    opts.frame_time = f64::NAN;
+    let opts = BvhWriteOptions {
+        frame_time: f64::NAN,
+        ..Default::default()
+    };
     assert!(bvh_string(&asf, &amc, &opts).is_err());
 }
