@@ -176,27 +176,34 @@ pub fn write_glb(path: impl AsRef<Path>, meshes: &[GlbMesh]) -> Result<()> {
     write_atomic(path, |w| w.write_all(&bytes))
 }
 
+/// Test fixture: a red icosphere and a default-coloured grid sheet, and their GLB bytes.
+#[cfg(test)]
+pub(crate) fn two_mesh_fixture() -> (TriMesh, TriMesh, Vec<u8>) {
+    let s = TriMesh::icosphere(1, 0.5);
+    let g = TriMesh::grid(3, 2, 0.1);
+    let bytes = encode_glb(&[
+        GlbMesh {
+            mesh: &s,
+            name: "sphere",
+            color: [1.0, 0.0, 0.0, 1.0],
+        },
+        GlbMesh {
+            mesh: &g,
+            name: "sheet",
+            color: DEFAULT_COLOR,
+        },
+    ])
+    .unwrap();
+    (s, g, bytes)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn layout_is_aligned_and_json_is_valid() {
-        let s = TriMesh::icosphere(1, 0.5);
-        let g = TriMesh::grid(3, 2, 0.1);
-        let bytes = encode_glb(&[
-            GlbMesh {
-                mesh: &s,
-                name: "sphere",
-                color: [1.0, 0.0, 0.0, 1.0],
-            },
-            GlbMesh {
-                mesh: &g,
-                name: "sheet",
-                color: DEFAULT_COLOR,
-            },
-        ])
-        .unwrap();
+        let (s, _, bytes) = two_mesh_fixture();
         assert_eq!(bytes.len() % 4, 0);
         assert_eq!(&bytes[0..4], b"glTF");
         let total = u32::from_le_bytes(bytes[8..12].try_into().unwrap()) as usize;

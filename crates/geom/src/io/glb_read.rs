@@ -430,7 +430,7 @@ pub fn read_glb_merged(path: impl AsRef<Path>) -> Result<TriMesh> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::glb::{assemble, encode_glb, GlbMesh, DEFAULT_COLOR};
+    use super::super::glb::{assemble, encode_glb, two_mesh_fixture, GlbMesh, DEFAULT_COLOR};
     use super::*;
     use serde_json::json;
 
@@ -440,21 +440,7 @@ mod tests {
 
     #[test]
     fn round_trip_two_meshes() {
-        let s = TriMesh::icosphere(1, 0.5);
-        let g = TriMesh::grid(3, 2, 0.1);
-        let bytes = encode_glb(&[
-            GlbMesh {
-                mesh: &s,
-                name: "sphere",
-                color: [1.0, 0.0, 0.0, 1.0],
-            },
-            GlbMesh {
-                mesh: &g,
-                name: "sheet",
-                color: DEFAULT_COLOR,
-            },
-        ])
-        .unwrap();
+        let (s, g, bytes) = two_mesh_fixture();
         let prims = parse_glb(&bytes, p()).unwrap();
         assert_eq!(prims.len(), 2);
         assert_eq!(prims[0].mesh, s);
