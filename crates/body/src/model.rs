@@ -16,6 +16,7 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
+use geom::io::le::from_le;
 use geom::TriMesh;
 use glam::{EulerRot, Quat, Vec3};
 use safetensors::{tensor::TensorView, Dtype, SafeTensors};
@@ -111,11 +112,11 @@ impl BodyModel {
             }
             Ok(t)
         };
-        let template: Vec<Vec3> = f32s(get("vertices", Dtype::F32)?.data())
+        let template: Vec<Vec3> = from_le::<f32>(get("vertices", Dtype::F32)?.data())
             .chunks_exact(3)
             .map(|c| Vec3::new(c[0], c[1], c[2]))
             .collect();
-        let faces: Vec<[u32; 3]> = u32s(get("faces", Dtype::U32)?.data())
+        let faces: Vec<[u32; 3]> = from_le::<u32>(get("faces", Dtype::U32)?.data())
             .chunks_exact(3)
             .map(|c| [c[0], c[1], c[2]])
             .collect();
@@ -137,8 +138,8 @@ impl BodyModel {
                 .ok_or_else(|| bad(format!("tpose names unknown bone {name}")))?;
             tpose.push((b, Vec3::from(e)));
         }
-        let reg_off = u32s(get("regressors.offsets", Dtype::U32)?.data());
-        let reg_idx = u32s(get("regressors.indices", Dtype::U32)?.data());
+        let reg_off = from_le::<u32>(get("regressors.offsets", Dtype::U32)?.data());
+        let reg_idx = from_le::<u32>(get("regressors.indices", Dtype::U32)?.data());
         let regressors = reg_off
             .windows(2)
             .map(|w| {
@@ -149,9 +150,9 @@ impl BodyModel {
             .collect::<Option<Vec<_>>>()
             .ok_or_else(|| bad("regressor offsets out of range".into()))?;
         let weights = SkinWeights {
-            offsets: u32s(get("weights.offsets", Dtype::U32)?.data()),
-            bones: u16s(get("weights.bones", Dtype::U16)?.data()),
-            weights: f32s(get("weights.values", Dtype::F32)?.data()),
+            offsets: from_le::<u32>(get("weights.offsets", Dtype::U32)?.data()),
+            bones: from_le::<u16>(get("weights.bones", Dtype::U16)?.data()),
+            weights: from_le::<f32>(get("weights.values", Dtype::F32)?.data()),
         };
         let mut targets = Vec::new();
         for (name, _) in st.tensors() {
@@ -161,9 +162,9 @@ impl BodyModel {
             else {
                 continue;
             };
-            let index = u16s(get(&name, Dtype::U16)?.data());
+            let index = from_le::<u16>(get(&name, Dtype::U16)?.data());
             let delta: Vec<[i16; 3]> =
-                i16s(get(&format!("target/{tname}/delta"), Dtype::I16)?.data())
+                from_le::<i16>(get(&format!("target/{tname}/delta"), Dtype::I16)?.data())
                     .chunks_exact(3)
                     .map(|c| [c[0], c[1], c[2]])
                     .collect();
@@ -350,25 +351,4 @@ impl ShapedBody {
             .sum::<f32>()
             / 6.0
     }
-}
-
-fn f32s(b: &[u8]) -> Vec<f32> {
-    b.chunks_exact(4)
-        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect()
-}
-fn u32s(b: &[u8]) -> Vec<u32> {
-    b.chunks_exact(4)
-        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect()
-}
-fn u16s(b: &[u8]) -> Vec<u16> {
-    b.chunks_exact(2)
-        .map(|c| u16::from_le_bytes([c[0], c[1]]))
-        .collect()
-}
-fn i16s(b: &[u8]) -> Vec<i16> {
-    b.chunks_exact(2)
-        .map(|c| i16::from_le_bytes([c[0], c[1]]))
-        .collect()
 }

@@ -74,25 +74,17 @@ fn neighbours(a: u8, b: u8) -> bool {
             .any(|&(x, y)| (x, y) == (a, b) || (y, x) == (a, b))
 }
 
+/// The segment (index into [`SEGMENTS`]) of every vertex `[N]` of `body`: the segment of
+/// its heaviest bone.
+pub fn vertex_segments(body: &ShapedBody) -> Vec<u8> {
+    let bone_segment: Vec<u8> = body.rig.bones.iter().map(|b| segment_of_bone(&b.name)).collect();
+    (0..body.weights.len()).map(|v| bone_segment[body.weights.heaviest(v)]).collect()
+}
+
 impl SelfContact {
     /// Segments the vertices of `body` by their heaviest bone.
     pub fn new(body: &ShapedBody) -> Self {
-        let bone_segment: Vec<u8> = body
-            .rig
-            .bones
-            .iter()
-            .map(|b| segment_of_bone(&b.name))
-            .collect();
-        let vertex_segment: Vec<u8> = (0..body.weights.len())
-            .map(|v| {
-                let (bone, _) =
-                    body.weights.row(v).fold(
-                        (0, -1.0),
-                        |best, (b, w)| if w > best.1 { (b, w) } else { best },
-                    );
-                bone_segment[bone]
-            })
-            .collect();
+        let vertex_segment = vertex_segments(body);
         let edges = geom::adjacency::edges(&body.mesh.faces)
             .into_iter()
             .filter(|e| vertex_segment[e[0] as usize] == vertex_segment[e[1] as usize])

@@ -3,6 +3,7 @@
 mod assets_cmd;
 mod bench_cmd;
 mod body_cmd;
+mod garment_cmd;
 mod output;
 mod pose_args;
 mod pose_cmd;
@@ -28,6 +29,9 @@ enum Cmd {
     Assets(assets_cmd::AssetsCmd),
     /// Make a body of a given shape and pose: mesh file, picture, or a picture sheet.
     Body(body_cmd::BodyArgs),
+    /// Garment templates: make, import, warp onto a body.
+    #[command(subcommand)]
+    Garment(garment_cmd::GarmentCmd),
     /// Pose files: convert CMU ASF/AMC clips to BVH.
     #[command(subcommand)]
     Pose(pose_cmd::PoseCmd),
@@ -42,6 +46,7 @@ fn main() {
         None => body_cmd::run(&body_cmd::BodyArgs::main_job()),
         Some(Cmd::Assets(c)) => assets_cmd::run(c),
         Some(Cmd::Body(a)) => body_cmd::run(a),
+        Some(Cmd::Garment(c)) => garment_cmd::run(c),
         Some(Cmd::Pose(c)) => pose_cmd::run(c),
         Some(Cmd::Bench(c)) => bench_cmd::run(c),
     };

@@ -16,6 +16,8 @@ pub mod mesh;
 pub mod metrics;
 pub mod normals;
 pub mod primitives;
+pub mod remesh;
+pub mod smooth;
 pub mod tri;
 
 pub use bvh::{Bvh, ClosestHit, SegmentHit};

@@ -7,6 +7,8 @@ use std::path::Path;
 use safetensors::{tensor::TensorView, Dtype};
 use serde_json::Value;
 
+use geom::io::le::to_le;
+
 use super::{BoneDef, BODY_VERTEX_COUNT, FORMAT};
 use crate::assets::WHEEL_SHA256;
 use crate::BodyError;
@@ -82,11 +84,11 @@ pub fn convert_assets(mpfb2: &Path, out: &Path) -> Result<(), BodyError> {
         .collect();
     tensors.insert(
         "vertices".into(),
-        (Dtype::F32, vec![kept.len(), 3], le(&vertices)),
+        (Dtype::F32, vec![kept.len(), 3], to_le(vertices.iter().copied())),
     );
     tensors.insert(
         "faces".into(),
-        (Dtype::U32, vec![faces.len() / 3, 3], le(&faces)),
+        (Dtype::U32, vec![faces.len() / 3, 3], to_le(faces.iter().copied())),
     );
     let (mut offsets, mut wb, mut wv) = (vec![0u32], Vec::<u16>::new(), Vec::<f32>::new());
     for row in &weight_rows {
@@ -99,15 +101,15 @@ pub fn convert_assets(mpfb2: &Path, out: &Path) -> Result<(), BodyError> {
     }
     tensors.insert(
         "weights.offsets".into(),
-        (Dtype::U32, vec![offsets.len()], le(&offsets)),
+        (Dtype::U32, vec![offsets.len()], to_le(offsets.iter().copied())),
     );
     tensors.insert(
         "weights.bones".into(),
-        (Dtype::U16, vec![wb.len()], le(&wb)),
+        (Dtype::U16, vec![wb.len()], to_le(wb.iter().copied())),
     );
     tensors.insert(
         "weights.values".into(),
-        (Dtype::F32, vec![wv.len()], le(&wv)),
+        (Dtype::F32, vec![wv.len()], to_le(wv.iter().copied())),
     );
     let mut reg_off = vec![0u32];
     let mut reg_idx: Vec<u32> = Vec::new();
@@ -117,11 +119,11 @@ pub fn convert_assets(mpfb2: &Path, out: &Path) -> Result<(), BodyError> {
     }
     tensors.insert(
         "regressors.offsets".into(),
-        (Dtype::U32, vec![reg_off.len()], le(&reg_off)),
+        (Dtype::U32, vec![reg_off.len()], to_le(reg_off.iter().copied())),
     );
     tensors.insert(
         "regressors.indices".into(),
-        (Dtype::U32, vec![reg_idx.len()], le(&reg_idx)),
+        (Dtype::U32, vec![reg_idx.len()], to_le(reg_idx.iter().copied())),
     );
 
     for dir in TARGET_DIRS {
@@ -142,11 +144,11 @@ pub fn convert_assets(mpfb2: &Path, out: &Path) -> Result<(), BodyError> {
             let (index, delta) = read_target(&path, &remap)?;
             tensors.insert(
                 format!("target/{name}/index"),
-                (Dtype::U16, vec![index.len()], le(&index)),
+                (Dtype::U16, vec![index.len()], to_le(index.iter().copied())),
             );
             tensors.insert(
                 format!("target/{name}/delta"),
-                (Dtype::I16, vec![index.len(), 3], le(&delta)),
+                (Dtype::I16, vec![index.len(), 3], to_le(delta.iter().copied())),
             );
         }
     }
@@ -180,19 +182,6 @@ pub fn convert_assets(mpfb2: &Path, out: &Path) -> Result<(), BodyError> {
     geom::io::write_atomic(out, |w| w.write_all(&bytes))
         .map_err(|e| BodyError::asset(out, e.to_string()))
 }
-
-/// Little-endian bytes of a slice of plain numbers.
-fn le<T: Copy + ToLe>(xs: &[T]) -> Vec<u8> {
-    xs.iter().flat_map(|x| x.to_le()).collect()
-}
-
-trait ToLe {
-    fn to_le(self) -> Vec<u8>;
-}
-macro_rules! to_le {
-    ($($t:ty),*) => {$(impl ToLe for $t { fn to_le(self) -> Vec<u8> { self.to_le_bytes().to_vec() } })*};
-}
-to_le!(f32, u32, u16, i16);
 
 fn read_base_obj(path: &Path) -> Result<BaseObj, BodyError> {
     let text = std::fs::read_to_string(path).map_err(|e| BodyError::asset(path, e.to_string()))?;

@@ -6,6 +6,7 @@
 mod atomic;
 mod glb;
 mod glb_read;
+pub mod le;
 mod obj;
 mod ply;
 

@@ -1,0 +1,57 @@
+//! Building a template: cut the body region, inflate it into cloth, remesh it to the
+//! target edge length, and give it weights and UVs.
+
+use body::{BodyModel, Phenotype};
+use geom::bvh::Bvh;
+use geom::remesh::{isotropic_remesh, RemeshOptions};
+
+use crate::inflate::{inflate, push_out, InflateOptions};
+use crate::region::garment_region;
+use crate::template::GarmentTemplate;
+use crate::uv::corner_uvs;
+use crate::weights::weights_from_correspondence;
+use crate::{CutParams, GarmentError, GarmentKind};
+
+/// Smallest and largest target edge length accepted, metres.
+pub const EDGE_RANGE: (f32, f32) = (0.004, 0.08);
+
+/// Builds the template of `kind` with `cut`, remeshed to edges of about `edge` metres
+/// (1 cm gives about 10k vertices for the T-shirt), on the template body (the default
+/// phenotype in rest pose).
+pub fn build_template(model: &BodyModel, kind: &GarmentKind, cut: &CutParams, edge: f32) -> Result<GarmentTemplate, GarmentError> {
+    cut.validate()?;
+    if !(EDGE_RANGE.0..=EDGE_RANGE.1).contains(&edge) {
+        return Err(GarmentError::Parameter(format!(
+            "edge length {edge} m is outside [{}, {}] m",
+            EDGE_RANGE.0, EDGE_RANGE.1
+        )));
+    }
+    let body = model.shape(&Phenotype::default())?;
+    let bvh = Bvh::from_mesh(&body.mesh)?;
+    let mut region = garment_region(&body, kind, cut)?;
+    let opts = InflateOptions::for_ease(cut.ease);
+    inflate(&mut region.mesh, &bvh, &opts)?;
+    let remeshed = isotropic_remesh(&region.mesh, &RemeshOptions::new(edge))?;
+    let mut mesh = remeshed.mesh;
+    push_out(&mut mesh.vertices, &bvh, opts.min_gap);
+    let weights = weights_from_correspondence(
+        &body,
+        &region.mesh.faces,
+        &region.body_vertex,
+        &remeshed.source_face,
+        &remeshed.source_bary,
+    )?;
+    let uvs = corner_uvs(&mesh, &weights, &body.rig);
+    let template = GarmentTemplate {
+        kind: kind.clone(),
+        cut: Some(*cut),
+        edge_length: edge,
+        mesh,
+        uvs,
+        weights,
+        body_phenotype: body.phenotype,
+        rig: body.rig,
+    };
+    template.validate()?;
+    Ok(template)
+}

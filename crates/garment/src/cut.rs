@@ -1,0 +1,161 @@
+//! Garment kinds and their cut parameters.
+//!
+//! Lengths are metres measured on the template body (the default phenotype in its rest
+//! A-pose, 1.626 m tall); warping carries a garment to other shapes and poses.
+
+use serde::{Deserialize, Serialize};
+
+use crate::GarmentError;
+
+/// The garments garnet builds, and user garments imported from a mesh.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GarmentKind {
+    /// Short-sleeved T-shirt: openings at the neck, the hem and two cuffs.
+    Tshirt,
+    /// Long-sleeved, looser and longer sweater: same openings as the T-shirt.
+    Sweater,
+    /// Jeans from the waist to the ankles: openings at the waist and two ankles.
+    Jeans,
+    /// A garment imported from a user's mesh, with its name.
+    Custom(String),
+}
+
+impl GarmentKind {
+    /// Parses `tshirt`, `sweater` or `jeans`.
+    pub fn parse(name: &str) -> Result<Self, GarmentError> {
+        match name.to_ascii_lowercase().replace(['-', '_'], "").as_str() {
+            "tshirt" => Ok(Self::Tshirt),
+            "sweater" => Ok(Self::Sweater),
+            "jeans" => Ok(Self::Jeans),
+            _ => Err(GarmentError::Parameter(format!(
+                "unknown garment '{name}' (expected tshirt, sweater or jeans)"
+            ))),
+        }
+    }
+
+    /// Lower-case name.
+    pub fn name(&self) -> &str {
+        match self {
+            Self::Tshirt => "tshirt",
+            Self::Sweater => "sweater",
+            Self::Jeans => "jeans",
+            Self::Custom(name) => name,
+        }
+    }
+
+    /// Whether the garment covers the upper body (sleeves, neck) or the legs.
+    pub fn is_top(&self) -> bool {
+        matches!(self, Self::Tshirt | Self::Sweater)
+    }
+
+    /// Number of openings (boundary loops) of a built template.
+    pub fn openings(&self) -> Option<usize> {
+        match self {
+            Self::Tshirt | Self::Sweater => Some(4),
+            Self::Jeans => Some(3),
+            Self::Custom(_) => None,
+        }
+    }
+}
+
+/// Cut parameters of a garment (metres on the template body). Parameters a kind does
+/// not use are ignored (`sleeve_length` and `neckline_depth` for jeans; `waist_height`
+/// and `leg_length` for tops).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CutParams {
+    /// Tops: from the base of the neck down to the hem.
+    pub body_length: f32,
+    /// Tops: from the shoulder joint along the arm to the cuff.
+    pub sleeve_length: f32,
+    /// Looseness: the garment's mean gap to the skin before draping.
+    pub ease: f32,
+    /// Tops: how far the front of the neckline drops below the neck base.
+    pub neckline_depth: f32,
+    /// Jeans: waistband height above the hip joint (negative: low-rise).
+    pub waist_height: f32,
+    /// Jeans: from the hip joint along the leg to the hem.
+    pub leg_length: f32,
+}
+
+/// Valid range of each parameter, `(name, min, max)`.
+pub const RANGES: [(&str, f32, f32); 6] = [
+    ("body_length", 0.35, 0.58),
+    ("sleeve_length", 0.06, 0.5),
+    ("ease", 0.005, 0.06),
+    ("neckline_depth", 0.0, 0.12),
+    ("waist_height", -0.06, 0.14),
+    ("leg_length", 0.2, 0.8),
+];
+
+impl CutParams {
+    /// The default cut of a kind: a regular T-shirt, a loose long sweater, full-length
+    /// jeans.
+    pub fn default_for(kind: &GarmentKind) -> Self {
+        match kind {
+            GarmentKind::Sweater => Self {
+                body_length: 0.56,
+                sleeve_length: 0.46,
+                ease: 0.03,
+                neckline_depth: 0.02,
+                ..Self::TSHIRT
+            },
+            GarmentKind::Jeans => Self {
+                ease: 0.015,
+                ..Self::TSHIRT
+            },
+            _ => Self::TSHIRT,
+        }
+    }
+
+    const TSHIRT: Self = Self {
+        body_length: 0.52,
+        sleeve_length: 0.2,
+        ease: 0.02,
+        neckline_depth: 0.04,
+        waist_height: 0.04,
+        leg_length: 0.75,
+    };
+
+    /// `(name, value)` of every parameter, in [`RANGES`] order.
+    pub fn named(&self) -> [(&'static str, f32); 6] {
+        [
+            ("body_length", self.body_length),
+            ("sleeve_length", self.sleeve_length),
+            ("ease", self.ease),
+            ("neckline_depth", self.neckline_depth),
+            ("waist_height", self.waist_height),
+            ("leg_length", self.leg_length),
+        ]
+    }
+
+    /// Checks every parameter is finite and within [`RANGES`].
+    pub fn validate(&self) -> Result<(), GarmentError> {
+        for ((name, v), (_, lo, hi)) in self.named().iter().zip(RANGES) {
+            if !v.is_finite() || *v < lo || *v > hi {
+                return Err(GarmentError::Parameter(format!(
+                    "{name} = {v} m is outside [{lo}, {hi}] m"
+                )));
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid_and_kinds_parse() {
+        for name in ["tshirt", "T-shirt", "sweater", "jeans"] {
+            let kind = GarmentKind::parse(name).unwrap();
+            CutParams::default_for(&kind).validate().unwrap();
+        }
+        assert!(GarmentKind::parse("hat").is_err());
+        let bad = CutParams { ease: f32::NAN, ..CutParams::default_for(&GarmentKind::Tshirt) };
+        assert!(bad.validate().unwrap_err().to_string().contains("ease"));
+        let bad = CutParams { sleeve_length: 2.0, ..CutParams::default_for(&GarmentKind::Tshirt) };
+        assert!(bad.validate().is_err());
+    }
+}

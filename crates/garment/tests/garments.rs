@@ -1,0 +1,156 @@
+//! Garment templates on the real body model: topology, fit, weights, warping, storage
+//! and import checks.
+
+use std::sync::OnceLock;
+
+use body::{BodyModel, Phenotype, Pose, Skinning};
+use garment::import::{import_garment, ImportLimits};
+use garment::warp::warp;
+use garment::{build_template, CutParams, GarmentKind, GarmentTemplate};
+use geom::bvh::Bvh;
+use geom::TriMesh;
+use glam::{Quat, Vec3};
+
+/// Coarse edges keep the tests fast; the 1 cm resolution is tested once.
+const EDGE: f32 = 0.025;
+
+fn model() -> &'static BodyModel {
+    static MODEL: OnceLock<BodyModel> = OnceLock::new();
+    MODEL.get_or_init(|| BodyModel::load().expect("body assets"))
+}
+
+fn templates() -> &'static [GarmentTemplate] {
+    static T: OnceLock<Vec<GarmentTemplate>> = OnceLock::new();
+    T.get_or_init(|| {
+        ["tshirt", "sweater", "jeans"]
+            .iter()
+            .map(|k| {
+                let kind = GarmentKind::parse(k).unwrap();
+                build_template(model(), &kind, &CutParams::default_for(&kind), EDGE).unwrap()
+            })
+            .collect()
+    })
+}
+
+#[test]
+fn templates_are_manifold_with_their_openings_only() {
+    for t in templates() {
+        let m = &t.mesh;
+        let report = geom::adjacency::check_manifold(m.vertices.len(), &m.faces).unwrap();
+        assert!(report.is_ok(), "{}: {report}", t.kind.name());
+        let loops = geom::adjacency::boundary_loops(m.vertices.len(), &m.faces).unwrap();
+        assert_eq!(Some(loops.len()), t.kind.openings(), "{}", t.kind.name());
+        assert_eq!(t.uvs.len(), m.faces.len());
+        assert!(t.uvs.iter().flatten().flatten().all(|u| (0.0..=1.0).contains(u)));
+    }
+}
+
+#[test]
+fn templates_sit_outside_the_body_with_ease() {
+    let body = model().shape(&Phenotype::default()).unwrap();
+    let bvh = Bvh::from_mesh(&body.mesh).unwrap();
+    for t in templates() {
+        let inside = t.mesh.vertices.iter().filter(|p| bvh.contains(**p)).count();
+        assert_eq!(inside, 0, "{}: vertices inside the body", t.kind.name());
+        let gaps: Vec<f32> = t.mesh.vertices.iter().map(|p| bvh.closest_point(*p).unwrap().distance).collect();
+        let mean = gaps.iter().sum::<f32>() / gaps.len() as f32;
+        assert!((0.008..0.06).contains(&mean), "{}: mean gap {mean} m", t.kind.name());
+        let min = gaps.iter().cloned().fold(f32::INFINITY, f32::min);
+        assert!(min > 0.003, "{}: closest vertex {min} m from the skin", t.kind.name());
+    }
+}
+
+#[test]
+fn weights_sum_to_one() {
+    for t in templates() {
+        for v in 0..t.weights.len() {
+            let s: f32 = t.weights.row(v).map(|(_, w)| w).sum();
+            assert!((s - 1.0).abs() < 1e-5, "{} vertex {v}: {s}", t.kind.name());
+        }
+    }
+}
+
+#[test]
+fn tshirt_at_one_centimetre_has_about_ten_thousand_vertices() {
+    let kind = GarmentKind::Tshirt;
+    let t = build_template(model(), &kind, &CutParams::default_for(&kind), 0.01).unwrap();
+    let n = t.mesh.vertices.len();
+    assert!((8_000..=12_000).contains(&n), "{n} vertices");
+}
+
+#[test]
+fn warping_onto_the_template_body_at_rest_is_the_identity() {
+    let body = model().shape(&Phenotype::default()).unwrap();
+    let rest = Pose::identity(body.rig.len());
+    for t in templates() {
+        for method in [Skinning::Dqs, Skinning::Lbs] {
+            let m = warp(t, &body, &rest, method).unwrap();
+            let err = m.vertices.iter().zip(&t.mesh.vertices).map(|(a, b)| (*a - *b).length()).fold(0.0, f32::max);
+            assert!(err < 1e-5, "{} {method:?}: {err} m", t.kind.name());
+        }
+    }
+}
+
+#[test]
+fn warping_follows_shape_and_pose() {
+    let target = model().shape(&Phenotype { gender: 0.0, height: 0.9, weight: 0.8, ..Default::default() }).unwrap();
+    let mut pose = Pose::identity(target.rig.len());
+    let arm = target.rig.index("LeftArm").unwrap();
+    pose.rotations[arm] = Quat::from_rotation_z(0.6);
+    let tshirt = &templates()[0];
+    let m = warp(tshirt, &target, &pose, Skinning::Dqs).unwrap();
+    assert!(m.vertices.iter().all(|p| p.is_finite()));
+    let top = |mesh: &TriMesh| mesh.vertices.iter().map(|p| p.y).fold(f32::MIN, f32::max);
+    assert!(top(&m) > top(&tshirt.mesh) + 0.05, "a taller body lifts the collar");
+    let mut nan = pose.clone();
+    nan.rotations[0] = Quat::from_xyzw(f32::NAN, 0.0, 0.0, 1.0);
+    assert!(warp(tshirt, &target, &nan, Skinning::Dqs).is_err());
+}
+
+#[test]
+fn template_files_round_trip_exactly_and_reject_corruption() {
+    let dir = tempfile::tempdir().unwrap();
+    for t in templates() {
+        let path = dir.path().join(format!("{}.garment", t.kind.name()));
+        t.save(&path).unwrap();
+        assert_eq!(&GarmentTemplate::load(&path).unwrap(), t);
+    }
+    let path = dir.path().join("jeans.garment");
+    let bytes = std::fs::read(&path).unwrap();
+    std::fs::write(&path, &bytes[..bytes.len() / 2]).unwrap();
+    let err = GarmentTemplate::load(&path).unwrap_err().to_string();
+    assert!(err.contains("jeans.garment"), "{err}");
+}
+
+#[test]
+fn import_accepts_a_fitted_mesh_and_refuses_bad_ones_with_reasons() {
+    let limits = ImportLimits::default();
+    let good = templates()[0].mesh.clone();
+    let t = import_garment(good.clone(), "my-shirt", model(), &limits).unwrap();
+    assert_eq!(t.kind, GarmentKind::Custom("my-shirt".into()));
+    assert_eq!(t.weights.len(), good.vertices.len());
+
+    let mut nan = good.clone();
+    nan.vertices[5].x = f32::NAN;
+    let err = import_garment(nan, "nan", model(), &limits).unwrap_err().to_string();
+    assert!(err.contains("NaN") || err.contains("finite"), "{err}");
+
+    let mut fan = good.clone();
+    let [a, b, _] = fan.faces[0];
+    let extra = fan.vertices.len() as u32;
+    fan.vertices.push(fan.vertices[a as usize] + Vec3::new(0.0, 0.0, 0.02));
+    fan.faces.push([a, b, extra]);
+    let err = import_garment(fan, "fan", model(), &limits).unwrap_err().to_string();
+    assert!(err.contains("manifold"), "{err}");
+
+    let mut far = good.clone();
+    far.vertices.iter_mut().for_each(|p| *p += Vec3::new(1.0, 0.0, 0.0));
+    let err = import_garment(far, "far", model(), &limits).unwrap_err().to_string();
+    assert!(err.contains("far from"), "{err}");
+
+    let mut inside = good;
+    let c = inside.vertices.iter().sum::<Vec3>() / inside.vertices.len() as f32;
+    inside.vertices.iter_mut().for_each(|p| *p = c + (*p - c) * 0.5);
+    let err = import_garment(inside, "inside", model(), &limits).unwrap_err().to_string();
+    assert!(err.contains("inside"), "{err}");
+}
