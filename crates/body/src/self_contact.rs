@@ -77,8 +77,15 @@ fn neighbours(a: u8, b: u8) -> bool {
 /// The segment (index into [`SEGMENTS`]) of every vertex `[N]` of `body`: the segment of
 /// its heaviest bone.
 pub fn vertex_segments(body: &ShapedBody) -> Vec<u8> {
-    let bone_segment: Vec<u8> = body.rig.bones.iter().map(|b| segment_of_bone(&b.name)).collect();
-    (0..body.weights.len()).map(|v| bone_segment[body.weights.heaviest(v)]).collect()
+    let bone_segment: Vec<u8> = body
+        .rig
+        .bones
+        .iter()
+        .map(|b| segment_of_bone(&b.name))
+        .collect();
+    (0..body.weights.len())
+        .map(|v| bone_segment[body.weights.heaviest(v)])
+        .collect()
 }
 
 impl SelfContact {

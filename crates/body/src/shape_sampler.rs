@@ -78,6 +78,21 @@ impl ShapeDistribution {
     /// weight parameters so that the mesh has the drawn stature and BMI (to about
     /// 2 mm and 0.2 kg/m^2 where the model can reach them).
     pub fn sample(&self, model: &BodyModel, seed: u64) -> Result<ShapeSample, BodyError> {
+        let (mut phenotype, target_stature, target_bmi) = self.draw(seed)?;
+        let (stature, bmi) =
+            solve_height_weight(model, &mut phenotype, target_stature, target_bmi)?;
+        Ok(ShapeSample {
+            phenotype,
+            target_stature,
+            stature,
+            target_bmi,
+            bmi,
+        })
+    }
+
+    /// The random part of [`ShapeDistribution::sample`]: a valid phenotype (height and
+    /// weight still at 0.5) with its target stature (m) and BMI (kg/m^2).
+    pub fn draw(&self, seed: u64) -> Result<(Phenotype, f32, f32), BodyError> {
         let mut rng = StdRng::seed_from_u64(seed);
         let female = rng.random::<f32>() < self.female_share;
         let (mean, sd) = if female {
@@ -101,8 +116,8 @@ impl ShapeDistribution {
                 break b;
             }
         };
-        let shares: [f32; 3] = std::array::from_fn(|_| rng.random::<f32>() + 0.05);
-        let mut phenotype = Phenotype {
+        let shares: [f32; 3] = std::array::from_fn(|_| rng.random_range(0.05..=1.0));
+        let phenotype = Phenotype {
             gender: if female {
                 rng.random_range(0.9..=1.0)
             } else {
@@ -119,15 +134,8 @@ impl ShapeDistribution {
             caucasian: shares[2],
             ..Phenotype::default()
         };
-        let (stature, bmi) =
-            solve_height_weight(model, &mut phenotype, target_stature, target_bmi)?;
-        Ok(ShapeSample {
-            phenotype,
-            target_stature,
-            stature,
-            target_bmi,
-            bmi,
-        })
+        phenotype.validate()?;
+        Ok((phenotype, target_stature, target_bmi))
     }
 }
 
@@ -219,4 +227,23 @@ fn newton_height_and(
         }
     }
     Ok(cur)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Regression: race shares were drawn up to 1.05, outside the valid range.
+    #[test]
+    fn every_draw_is_a_valid_phenotype() {
+        let dist = ShapeDistribution::default();
+        for seed in 0..5000 {
+            let (p, stature, bmi) = dist.draw(seed).unwrap();
+            assert!(p.validate().is_ok(), "seed {seed}: {p:?}");
+            assert!(
+                (1.4..2.0).contains(&stature) && (17.0..=38.0).contains(&bmi),
+                "seed {seed}"
+            );
+        }
+    }
 }

@@ -72,7 +72,12 @@ impl SkinWeights {
 
     /// The bone with the largest weight on vertex `v` (the first of equal ones).
     pub fn heaviest(&self, v: usize) -> usize {
-        self.row(v).fold((0, -1.0), |best, (b, w)| if w > best.1 { (b, w) } else { best }).0
+        self.row(v)
+            .fold(
+                (0, -1.0),
+                |best, (b, w)| if w > best.1 { (b, w) } else { best },
+            )
+            .0
     }
 
     /// Skins rest positions `rest` `[N]` with per-bone `transforms` `[B]`, returning the

@@ -6,7 +6,7 @@ use anyhow::Context;
 use body::BodyModel;
 use clap::{Args, Subcommand, ValueEnum};
 use garment::import::{import_garment, ImportLimits};
-use garment::warp::warp;
+use garment::warp::{warp, warp_fitted, SurfaceAnchors};
 use garment::{build_template, CutParams, GarmentKind, GarmentTemplate};
 use render::palette;
 
@@ -37,6 +37,19 @@ pub enum GarmentCmd {
     },
     /// Warp a template onto a body of any shape and pose (DQS, or LBS).
     Warp(WarpArgs),
+    /// Picture sheet: the three templates on the template body, and each warped onto
+    /// three random shapes in three poses (walk, arms raised, sitting).
+    Sheet {
+        /// The PNG to write.
+        #[arg(long, default_value = "docs/garments.png")]
+        out: PathBuf,
+        /// Template edge length, metres.
+        #[arg(long, default_value_t = 0.01)]
+        edge: f32,
+        /// Folder of the CMU clips (the walk comes from 02/02_01.amc).
+        #[arg(long, value_name = "DIR", default_value = "../shared/mocap/cmu")]
+        mocap: PathBuf,
+    },
 }
 
 /// Garment kinds on the command line.
@@ -97,6 +110,10 @@ pub struct WarpArgs {
     /// Skinning method.
     #[arg(long, value_enum, default_value_t = SkinningArg::Dqs)]
     pub skinning: SkinningArg,
+    /// The paper's M: skin the template with the joints only, without first carrying
+    /// it over the body's change of shape (girth) by its surface anchors.
+    #[arg(long)]
+    pub joints_only: bool,
     /// The warped garment mesh (.obj, .ply, .glb).
     #[arg(long, default_value = "out/warped.obj")]
     pub out: PathBuf,
@@ -132,26 +149,53 @@ pub fn run(cmd: &GarmentCmd) -> anyhow::Result<()> {
     let model = BodyModel::load()?;
     match cmd {
         GarmentCmd::Make(args) => make(&model, args),
-        GarmentCmd::Import { file, name, out, png } => {
+        GarmentCmd::Import {
+            file,
+            name,
+            out,
+            png,
+        } => {
             let mesh = geom::io::read_mesh(file)?;
-            let name = name.clone().unwrap_or_else(|| crate::pose_args::file_name(file));
+            let name = name
+                .clone()
+                .unwrap_or_else(|| crate::pose_args::file_name(file));
             let template = import_garment(mesh, &name, &model, &ImportLimits::default())?;
             save(&template, out)?;
             picture_on_template_body(&model, &template, png.as_deref())
+        }
+        GarmentCmd::Sheet { out, edge, mocap } => {
+            crate::garment_sheet::write_sheet(&model, out, *edge, mocap)
         }
         GarmentCmd::Warp(args) => {
             let template = GarmentTemplate::load(&args.template)?;
             let body = model.shape(&args.shape.phenotype(&model)?)?;
             let (pose, what) = args.pose.pose(&model, &body)?;
-            let warped = warp(&template, &body, &pose, args.skinning.into())?;
-            eprintln!("{} warped onto a {:.1} cm body, pose: {what}", template.kind.name(), body.height() * 100.0);
+            let warped = if args.joints_only {
+                warp(&template, &body, &pose, args.skinning.into())?
+            } else {
+                let template_body = model.shape(&template.body_phenotype)?;
+                let anchors = SurfaceAnchors::new(&template.mesh, &template_body.mesh)?;
+                warp_fitted(&template, &anchors, &body, &pose, args.skinning.into())?
+            };
+            eprintln!(
+                "{} warped onto a {:.1} cm body, pose: {what}",
+                template.kind.name(),
+                body.height() * 100.0
+            );
             write_mesh(&args.out, &warped)?;
             let posed = body.posed(&pose, args.skinning.into())?;
             if let Some(path) = &args.body_out {
                 write_mesh(path, &posed)?;
             }
             if let Some(png) = &args.png {
-                write_png(png, &[(&posed, palette::SKIN), (&warped, garment_color(&template.kind))], (480, 720))?;
+                write_png(
+                    png,
+                    &[
+                        (&posed, palette::SKIN),
+                        (&warped, garment_color(&template.kind)),
+                    ],
+                    (480, 720),
+                )?;
             }
             Ok(())
         }
@@ -178,7 +222,10 @@ fn make(model: &BodyModel, args: &MakeArgs) -> anyhow::Result<()> {
         template.mesh.faces.len(),
         t0.elapsed().as_secs_f32()
     );
-    let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("out/{}.garment", kind.name())));
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("out/{}.garment", kind.name())));
     save(&template, &out)?;
     if let Some(path) = &args.mesh {
         write_mesh(path, &template.mesh)?;
@@ -188,13 +235,26 @@ fn make(model: &BodyModel, args: &MakeArgs) -> anyhow::Result<()> {
 
 fn save(template: &GarmentTemplate, out: &Path) -> anyhow::Result<()> {
     create_parent(out)?;
-    template.save(out).with_context(|| format!("writing {}", out.display()))?;
+    template
+        .save(out)
+        .with_context(|| format!("writing {}", out.display()))?;
     eprintln!("wrote {}", out.display());
     Ok(())
 }
 
-fn picture_on_template_body(model: &BodyModel, template: &GarmentTemplate, png: Option<&Path>) -> anyhow::Result<()> {
+fn picture_on_template_body(
+    model: &BodyModel,
+    template: &GarmentTemplate,
+    png: Option<&Path>,
+) -> anyhow::Result<()> {
     let Some(png) = png else { return Ok(()) };
     let body = model.shape(&template.body_phenotype)?;
-    write_png(png, &[(&body.mesh, palette::SKIN), (&template.mesh, garment_color(&template.kind))], (480, 720))
+    write_png(
+        png,
+        &[
+            (&body.mesh, palette::SKIN),
+            (&template.mesh, garment_color(&template.kind)),
+        ],
+        (480, 720),
+    )
 }

@@ -4,6 +4,7 @@ mod assets_cmd;
 mod bench_cmd;
 mod body_cmd;
 mod garment_cmd;
+mod garment_sheet;
 mod output;
 mod pose_args;
 mod pose_cmd;

@@ -203,3 +203,94 @@ fn missing_pip_or_bad_assets_folder_give_clear_errors() {
     );
     assert!(!home.path().join("body-v1.safetensors").exists());
 }
+
+#[test]
+fn garment_make_import_warp() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    ok(&[
+        "garment",
+        "make",
+        "jeans",
+        "--edge",
+        "0.03",
+        "--out",
+        s(&p("j.garment")),
+        "--mesh",
+        s(&p("j.obj")),
+        "--png",
+        s(&p("j.png")),
+    ]);
+    let t = garment::GarmentTemplate::load(&p("j.garment")).unwrap();
+    assert_eq!(t.kind, garment::GarmentKind::Jeans);
+    assert_eq!(
+        geom::io::read_mesh(p("j.obj")).unwrap().vertices.len(),
+        t.mesh.vertices.len()
+    );
+    assert!(p("j.png").is_file());
+
+    ok(&[
+        "garment",
+        "import",
+        s(&p("j.obj")),
+        "--name",
+        "my-jeans",
+        "--out",
+        s(&p("mine.garment")),
+    ]);
+    let mine = garment::GarmentTemplate::load(&p("mine.garment")).unwrap();
+    assert_eq!(mine.kind, garment::GarmentKind::Custom("my-jeans".into()));
+
+    let (template, ply, png) = (p("mine.garment"), p("w.ply"), p("w.png"));
+    for extra in [&[][..], &["--joints-only"][..]] {
+        let mut args = vec![
+            "garment",
+            "warp",
+            "--template",
+            s(&template),
+            "--random-shape",
+            "3",
+        ];
+        args.extend_from_slice(&["--pose-procedural", "3", "--out", s(&ply), "--png", s(&png)]);
+        args.extend_from_slice(extra);
+        ok(&args);
+        assert_eq!(
+            geom::io::read_mesh(p("w.ply")).unwrap().vertices.len(),
+            t.mesh.vertices.len()
+        );
+    }
+}
+
+#[test]
+fn garment_commands_refuse_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    let err = fails(&[
+        "garment",
+        "make",
+        "tshirt",
+        "--ease",
+        "0.5",
+        "--out",
+        s(&p("t.garment")),
+    ]);
+    assert!(err.contains("ease"), "{err}");
+    assert!(!p("t.garment").exists());
+    // A box a metre away from the body is not a garment for it.
+    let mut cube = geom::TriMesh::cuboid(glam::Vec3::splat(0.15));
+    cube.vertices
+        .iter_mut()
+        .for_each(|v| *v += glam::Vec3::new(1.2, 1.0, 0.0));
+    geom::io::write_mesh(p("far.obj"), &cube).unwrap();
+    let err = fails(&[
+        "garment",
+        "import",
+        s(&p("far.obj")),
+        "--out",
+        s(&p("far.garment")),
+    ]);
+    assert!(err.contains("far from the template body"), "{err}");
+    std::fs::write(p("bad.garment"), b"not a template").unwrap();
+    let err = fails(&["garment", "warp", "--template", s(&p("bad.garment"))]);
+    assert!(err.contains("bad.garment"), "{err}");
+}

@@ -8,7 +8,6 @@ use geom::remesh::{isotropic_remesh, RemeshOptions};
 use crate::inflate::{inflate, push_out, InflateOptions};
 use crate::region::garment_region;
 use crate::template::GarmentTemplate;
-use crate::uv::corner_uvs;
 use crate::weights::weights_from_correspondence;
 use crate::{CutParams, GarmentError, GarmentKind};
 
@@ -18,7 +17,12 @@ pub const EDGE_RANGE: (f32, f32) = (0.004, 0.08);
 /// Builds the template of `kind` with `cut`, remeshed to edges of about `edge` metres
 /// (1 cm gives about 10k vertices for the T-shirt), on the template body (the default
 /// phenotype in rest pose).
-pub fn build_template(model: &BodyModel, kind: &GarmentKind, cut: &CutParams, edge: f32) -> Result<GarmentTemplate, GarmentError> {
+pub fn build_template(
+    model: &BodyModel,
+    kind: &GarmentKind,
+    cut: &CutParams,
+    edge: f32,
+) -> Result<GarmentTemplate, GarmentError> {
     cut.validate()?;
     if !(EDGE_RANGE.0..=EDGE_RANGE.1).contains(&edge) {
         return Err(GarmentError::Parameter(format!(
@@ -41,17 +45,5 @@ pub fn build_template(model: &BodyModel, kind: &GarmentKind, cut: &CutParams, ed
         &remeshed.source_face,
         &remeshed.source_bary,
     )?;
-    let uvs = corner_uvs(&mesh, &weights, &body.rig);
-    let template = GarmentTemplate {
-        kind: kind.clone(),
-        cut: Some(*cut),
-        edge_length: edge,
-        mesh,
-        uvs,
-        weights,
-        body_phenotype: body.phenotype,
-        rig: body.rig,
-    };
-    template.validate()?;
-    Ok(template)
+    GarmentTemplate::assemble(kind.clone(), Some(*cut), edge, mesh, weights, body)
 }

@@ -80,7 +80,7 @@ pub struct CutParams {
 
 /// Valid range of each parameter, `(name, min, max)`.
 pub const RANGES: [(&str, f32, f32); 6] = [
-    ("body_length", 0.35, 0.58),
+    ("body_length", 0.35, 0.62),
     ("sleeve_length", 0.06, 0.5),
     ("ease", 0.005, 0.06),
     ("neckline_depth", 0.0, 0.12),
@@ -94,14 +94,14 @@ impl CutParams {
     pub fn default_for(kind: &GarmentKind) -> Self {
         match kind {
             GarmentKind::Sweater => Self {
-                body_length: 0.56,
+                body_length: 0.6,
                 sleeve_length: 0.46,
-                ease: 0.03,
+                ease: 0.04,
                 neckline_depth: 0.02,
                 ..Self::TSHIRT
             },
             GarmentKind::Jeans => Self {
-                ease: 0.015,
+                ease: 0.02,
                 ..Self::TSHIRT
             },
             _ => Self::TSHIRT,
@@ -109,9 +109,9 @@ impl CutParams {
     }
 
     const TSHIRT: Self = Self {
-        body_length: 0.52,
-        sleeve_length: 0.2,
-        ease: 0.02,
+        body_length: 0.59,
+        sleeve_length: 0.28,
+        ease: 0.03,
         neckline_depth: 0.04,
         waist_height: 0.04,
         leg_length: 0.75,
@@ -153,9 +153,15 @@ mod tests {
             CutParams::default_for(&kind).validate().unwrap();
         }
         assert!(GarmentKind::parse("hat").is_err());
-        let bad = CutParams { ease: f32::NAN, ..CutParams::default_for(&GarmentKind::Tshirt) };
+        let bad = CutParams {
+            ease: f32::NAN,
+            ..CutParams::default_for(&GarmentKind::Tshirt)
+        };
         assert!(bad.validate().unwrap_err().to_string().contains("ease"));
-        let bad = CutParams { sleeve_length: 2.0, ..CutParams::default_for(&GarmentKind::Tshirt) };
+        let bad = CutParams {
+            sleeve_length: 2.0,
+            ..CutParams::default_for(&GarmentKind::Tshirt)
+        };
         assert!(bad.validate().is_err());
     }
 }

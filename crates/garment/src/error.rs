@@ -25,11 +25,17 @@ pub enum GarmentError {
 impl GarmentError {
     /// A [`GarmentError::File`] error for `path`.
     pub fn file(path: impl Into<PathBuf>, message: impl Into<String>) -> Self {
-        Self::File { path: path.into(), message: message.into() }
+        Self::File {
+            path: path.into(),
+            message: message.into(),
+        }
     }
 
     /// A [`GarmentError::Rejected`] error.
     pub fn rejected(what: impl Into<String>, reason: impl Into<String>) -> Self {
-        Self::Rejected { what: what.into(), reason: reason.into() }
+        Self::Rejected {
+            what: what.into(),
+            reason: reason.into(),
+        }
     }
 }

@@ -6,7 +6,6 @@ use geom::TriMesh;
 use rayon::prelude::*;
 
 use crate::template::GarmentTemplate;
-use crate::uv::corner_uvs;
 use crate::weights::transfer_weights;
 use crate::{GarmentError, GarmentKind};
 
@@ -25,7 +24,12 @@ pub struct ImportLimits {
 
 impl Default for ImportLimits {
     fn default() -> Self {
-        Self { max_inside_share: 0.01, max_mean_gap: 0.10, extent: (0.1, 2.5), max_vertices: 200_000 }
+        Self {
+            max_inside_share: 0.01,
+            max_mean_gap: 0.10,
+            extent: (0.1, 2.5),
+            max_vertices: 200_000,
+        }
     }
 }
 
@@ -33,11 +37,20 @@ impl Default for ImportLimits {
 /// makes a template of it named `name`: weights transferred from the body, UVs by body
 /// part. Refuses, with the reason, a mesh with NaN or bad indices, a non-manifold or
 /// inconsistently oriented mesh, an implausible size, one inside the body or far from it.
-pub fn import_garment(mesh: TriMesh, name: &str, model: &BodyModel, limits: &ImportLimits) -> Result<GarmentTemplate, GarmentError> {
+pub fn import_garment(
+    mesh: TriMesh,
+    name: &str,
+    model: &BodyModel,
+    limits: &ImportLimits,
+) -> Result<GarmentTemplate, GarmentError> {
     let reject = |reason: String| GarmentError::rejected(format!("garment '{name}'"), reason);
     mesh.validate().map_err(|e| reject(e.to_string()))?;
     if mesh.faces.is_empty() || mesh.vertices.len() > limits.max_vertices {
-        return Err(reject(format!("has {} vertices and {} faces", mesh.vertices.len(), mesh.faces.len())));
+        return Err(reject(format!(
+            "has {} vertices and {} faces",
+            mesh.vertices.len(),
+            mesh.faces.len()
+        )));
     }
     let (lo, hi) = mesh.bounds().expect("non-empty mesh");
     let extent = (hi - lo).max_element();
@@ -51,14 +64,23 @@ pub fn import_garment(mesh: TriMesh, name: &str, model: &BodyModel, limits: &Imp
     }
     let report = geom::adjacency::check_manifold(mesh.vertices.len(), &mesh.faces)?;
     if !report.is_ok() {
-        return Err(reject(format!("is not a manifold, consistently oriented surface: {report}")));
+        return Err(reject(format!(
+            "is not a manifold, consistently oriented surface: {report}"
+        )));
     }
     let body = model.shape(&Phenotype::default())?;
     let bvh = Bvh::from_mesh(&body.mesh)?;
-    let inside = mesh.vertices.par_iter().filter(|p| bvh.contains(**p)).count();
+    let inside = mesh
+        .vertices
+        .par_iter()
+        .filter(|p| bvh.contains(**p))
+        .count();
     let share = inside as f32 / mesh.vertices.len() as f32;
     if share > limits.max_inside_share {
-        return Err(reject(format!("has {:.1}% of its vertices inside the template body", share * 100.0)));
+        return Err(reject(format!(
+            "has {:.1}% of its vertices inside the template body",
+            share * 100.0
+        )));
     }
     let mean_gap = mesh
         .vertices
@@ -74,17 +96,13 @@ pub fn import_garment(mesh: TriMesh, name: &str, model: &BodyModel, limits: &Imp
         )));
     }
     let weights = transfer_weights(&mesh, &body, &bvh, 3)?;
-    let uvs = corner_uvs(&mesh, &weights, &body.rig);
-    let template = GarmentTemplate {
-        kind: GarmentKind::Custom(name.to_string()),
-        cut: None,
-        edge_length: mesh.mean_edge_length(),
+    let edge_length = mesh.mean_edge_length();
+    GarmentTemplate::assemble(
+        GarmentKind::Custom(name.to_string()),
+        None,
+        edge_length,
         mesh,
-        uvs,
         weights,
-        body_phenotype: body.phenotype,
-        rig: body.rig,
-    };
-    template.validate()?;
-    Ok(template)
+        body,
+    )
 }

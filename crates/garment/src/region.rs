@@ -40,14 +40,24 @@ fn along_chain(p: Vec3, upper: (Vec3, Vec3), lower: (Vec3, Vec3), on_lower: bool
 }
 
 /// Which body vertices a garment of `kind` with `cut` covers on `body` (rest pose).
-pub fn covered_vertices(body: &ShapedBody, kind: &GarmentKind, cut: &CutParams) -> Result<Vec<bool>, GarmentError> {
+pub fn covered_vertices(
+    body: &ShapedBody,
+    kind: &GarmentKind,
+    cut: &CutParams,
+) -> Result<Vec<bool>, GarmentError> {
     let rig = &body.rig;
     let bone = |name: &str| -> Result<(Vec3, Vec3), GarmentError> {
-        let b = rig.index(name).ok_or_else(|| GarmentError::Parameter(format!("the rig has no bone {name}")))?;
+        let b = rig
+            .index(name)
+            .ok_or_else(|| GarmentError::Parameter(format!("the rig has no bone {name}")))?;
         Ok((rig.bones[b].head, rig.bones[b].tail))
     };
     let seg = vertex_segments(body);
-    let is_hand: Vec<bool> = rig.bones.iter().map(|b| b.name.contains("Hand") || b.name.contains("Finger") || b.name.contains("Thumb")).collect();
+    let is_hand: Vec<bool> = rig
+        .bones
+        .iter()
+        .map(|b| b.name.contains("Hand") || b.name.contains("Finger") || b.name.contains("Thumb"))
+        .collect();
     let v = &body.mesh.vertices;
     let keep: Vec<bool> = match kind {
         GarmentKind::Tshirt | GarmentKind::Sweater => {
@@ -73,7 +83,9 @@ pub fn covered_vertices(body: &ShapedBody, kind: &GarmentKind, cut: &CutParams) 
                         0 | 5 | 7 => p.y >= hem && below_neckline,
                         _ if is_hand[body.weights.heaviest(i)] => false,
                         _ => arms.iter().any(|&(up, low, su, sl)| {
-                            (s == su || s == sl) && along_chain(p, up, low, s == sl) <= cut.sleeve_length && p.y >= hem
+                            (s == su || s == sl)
+                                && along_chain(p, up, low, s == sl) <= cut.sleeve_length
+                                && p.y >= hem
                         }),
                     }
                 })
@@ -92,14 +104,18 @@ pub fn covered_vertices(body: &ShapedBody, kind: &GarmentKind, cut: &CutParams) 
                         0 => p.y <= waist,
                         1..=4 => false,
                         _ => legs.iter().any(|&(up, low, su, sl)| {
-                            (s == su || s == sl) && along_chain(p, up, low, s == sl) <= cut.leg_length && p.y <= waist
+                            (s == su || s == sl)
+                                && along_chain(p, up, low, s == sl) <= cut.leg_length
+                                && p.y <= waist
                         }),
                     }
                 })
                 .collect()
         }
         GarmentKind::Custom(name) => {
-            return Err(GarmentError::Parameter(format!("'{name}' is imported, not cut from the body")));
+            return Err(GarmentError::Parameter(format!(
+                "'{name}' is imported, not cut from the body"
+            )));
         }
     };
     Ok(keep)
@@ -107,10 +123,17 @@ pub fn covered_vertices(body: &ShapedBody, kind: &GarmentKind, cut: &CutParams) 
 
 /// The region of `body` covered by a garment: covered faces, enclosed gaps filled.
 /// Errors if the result does not have the kind's number of openings.
-pub fn garment_region(body: &ShapedBody, kind: &GarmentKind, cut: &CutParams) -> Result<Region, GarmentError> {
+pub fn garment_region(
+    body: &ShapedBody,
+    kind: &GarmentKind,
+    cut: &CutParams,
+) -> Result<Region, GarmentError> {
     let keep = covered_vertices(body, kind, cut)?;
     let faces = &body.mesh.faces;
-    let mut in_region: Vec<bool> = faces.iter().map(|f| f.iter().all(|&i| keep[i as usize])).collect();
+    let mut in_region: Vec<bool> = faces
+        .iter()
+        .map(|f| f.iter().all(|&i| keep[i as usize]))
+        .collect();
     fill_small_gaps(faces, body.mesh.vertices.len(), &mut in_region)?;
     let region = extract(&body.mesh, &in_region);
     let loops = geom::adjacency::boundary_loops(region.mesh.vertices.len(), &region.mesh.faces)?;
@@ -118,7 +141,10 @@ pub fn garment_region(body: &ShapedBody, kind: &GarmentKind, cut: &CutParams) ->
         if loops.len() != expected {
             return Err(GarmentError::rejected(
                 format!("{} region", kind.name()),
-                format!("has {} openings, expected {expected}: adjust the cut parameters", loops.len()),
+                format!(
+                    "has {} openings, expected {expected}: adjust the cut parameters",
+                    loops.len()
+                ),
             ));
         }
     }
@@ -127,7 +153,11 @@ pub fn garment_region(body: &ShapedBody, kind: &GarmentKind, cut: &CutParams) ->
 
 /// Adds to the region every connected group of excluded faces smaller than
 /// [`MAX_GAP_FACES`] (holes left where the covered set is not convex).
-fn fill_small_gaps(faces: &[[u32; 3]], n: usize, in_region: &mut [bool]) -> Result<(), GarmentError> {
+fn fill_small_gaps(
+    faces: &[[u32; 3]],
+    n: usize,
+    in_region: &mut [bool],
+) -> Result<(), GarmentError> {
     let topo = geom::adjacency::EdgeTopology::new(n, faces)?;
     let mut seen = vec![false; faces.len()];
     for start in 0..faces.len() {
@@ -173,6 +203,12 @@ fn extract(mesh: &TriMesh, in_region: &[bool]) -> Region {
             map[i as usize]
         }));
     }
-    let vertices = body_vertex.iter().map(|&i| mesh.vertices[i as usize]).collect();
-    Region { mesh: TriMesh { vertices, faces }, body_vertex }
+    let vertices = body_vertex
+        .iter()
+        .map(|&i| mesh.vertices[i as usize])
+        .collect();
+    Region {
+        mesh: TriMesh { vertices, faces },
+        body_vertex,
+    }
 }

@@ -10,8 +10,14 @@ use glam::{Vec2, Vec3};
 
 /// Per-face-corner UVs `[F]` in [0, 1]^2 for `mesh` skinned with `weights` to `rig`.
 pub fn corner_uvs(mesh: &TriMesh, weights: &SkinWeights, rig: &Rig) -> Vec<[[f32; 2]; 3]> {
-    let bone_chart: Vec<usize> = rig.bones.iter().map(|b| chart_of_segment(segment_of_bone(&b.name))).collect();
-    let vertex_chart: Vec<usize> = (0..mesh.vertices.len()).map(|v| bone_chart[weights.heaviest(v)]).collect();
+    let bone_chart: Vec<usize> = rig
+        .bones
+        .iter()
+        .map(|b| chart_of_segment(segment_of_bone(&b.name)))
+        .collect();
+    let vertex_chart: Vec<usize> = (0..mesh.vertices.len())
+        .map(|v| bone_chart[weights.heaviest(v)])
+        .collect();
     let axes = chart_axes(rig);
     // (arc length around the axis, distance along it), metres, per corner.
     let mut raw: Vec<(usize, [Vec2; 3])> = mesh
@@ -64,7 +70,12 @@ impl Axis {
     fn new(origin: Vec3, dir: Vec3, radius: f32) -> Self {
         let dir = dir.normalize_or(Vec3::Y);
         let reference = (Vec3::Z - dir * dir.z).normalize_or(Vec3::X);
-        Self { origin, dir, reference, radius }
+        Self {
+            origin,
+            dir,
+            reference,
+            radius,
+        }
     }
 
     /// (angle around the axis in (-pi, pi], distance along it) of `p`.
@@ -78,7 +89,10 @@ impl Axis {
 }
 
 fn chart_axes(rig: &Rig) -> Vec<Axis> {
-    let joint = |name: &str| rig.index(name).map(|i| (rig.bones[i].head, rig.bones[i].tail));
+    let joint = |name: &str| {
+        rig.index(name)
+            .map(|i| (rig.bones[i].head, rig.bones[i].tail))
+    };
     let limb = |upper: &str, lower: &str, radius: f32| match (joint(upper), joint(lower)) {
         (Some((h, _)), Some((_, t))) => Axis::new(h, t - h, radius),
         _ => Axis::new(Vec3::ZERO, Vec3::Y, radius),

@@ -24,13 +24,23 @@ fn sparsify(dense: &[Vec<f32>]) -> Result<SkinWeights, GarmentError> {
     let rows: Vec<Vec<(u16, f32)>> = dense
         .iter()
         .map(|d| {
-            let mut row: Vec<(u16, f32)> = d.iter().enumerate().filter(|(_, w)| **w > 1e-4).map(|(b, w)| (b as u16, *w)).collect();
+            let mut row: Vec<(u16, f32)> = d
+                .iter()
+                .enumerate()
+                .filter(|(_, w)| **w > 1e-4)
+                .map(|(b, w)| (b as u16, *w))
+                .collect();
             row.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
             row.truncate(MAX_INFLUENCES);
             row
         })
         .collect();
-    SkinWeights::from_rows(&rows).map_err(|v| GarmentError::rejected("skinning weights", format!("garment vertex {v} has no weight")))
+    SkinWeights::from_rows(&rows).map_err(|v| {
+        GarmentError::rejected(
+            "skinning weights",
+            format!("garment vertex {v} has no weight"),
+        )
+    })
 }
 
 /// Weights of points given by barycentric coordinates `bary` `[M]` on faces `face` `[M]`
@@ -66,7 +76,12 @@ pub fn weights_from_correspondence(
 /// weights of its closest body point (interpolated over the body face), then
 /// `smoothing` rounds of averaging over the garment's 1-ring remove the seams this
 /// leaves where the closest point jumps between body parts.
-pub fn transfer_weights(garment: &TriMesh, body: &ShapedBody, body_bvh: &Bvh, smoothing: usize) -> Result<SkinWeights, GarmentError> {
+pub fn transfer_weights(
+    garment: &TriMesh,
+    body: &ShapedBody,
+    body_bvh: &Bvh,
+    smoothing: usize,
+) -> Result<SkinWeights, GarmentError> {
     let bones = body.rig.len();
     let mut dense: Vec<Vec<f32>> = garment
         .vertices
@@ -76,7 +91,10 @@ pub fn transfer_weights(garment: &TriMesh, body: &ShapedBody, body_bvh: &Bvh, sm
             let f = body.mesh.faces[hit.face as usize];
             let mut row = vec![0.0; bones];
             for (k, &v) in f.iter().enumerate() {
-                for (b, w) in dense_row(&body.weights, v as usize, bones).iter().enumerate() {
+                for (b, w) in dense_row(&body.weights, v as usize, bones)
+                    .iter()
+                    .enumerate()
+                {
                     row[b] += hit.bary[k] * w;
                 }
             }

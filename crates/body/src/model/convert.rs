@@ -84,11 +84,19 @@ pub fn convert_assets(mpfb2: &Path, out: &Path) -> Result<(), BodyError> {
         .collect();
     tensors.insert(
         "vertices".into(),
-        (Dtype::F32, vec![kept.len(), 3], to_le(vertices.iter().copied())),
+        (
+            Dtype::F32,
+            vec![kept.len(), 3],
+            to_le(vertices.iter().copied()),
+        ),
     );
     tensors.insert(
         "faces".into(),
-        (Dtype::U32, vec![faces.len() / 3, 3], to_le(faces.iter().copied())),
+        (
+            Dtype::U32,
+            vec![faces.len() / 3, 3],
+            to_le(faces.iter().copied()),
+        ),
     );
     let (mut offsets, mut wb, mut wv) = (vec![0u32], Vec::<u16>::new(), Vec::<f32>::new());
     for row in &weight_rows {
@@ -101,7 +109,11 @@ pub fn convert_assets(mpfb2: &Path, out: &Path) -> Result<(), BodyError> {
     }
     tensors.insert(
         "weights.offsets".into(),
-        (Dtype::U32, vec![offsets.len()], to_le(offsets.iter().copied())),
+        (
+            Dtype::U32,
+            vec![offsets.len()],
+            to_le(offsets.iter().copied()),
+        ),
     );
     tensors.insert(
         "weights.bones".into(),
@@ -119,11 +131,19 @@ pub fn convert_assets(mpfb2: &Path, out: &Path) -> Result<(), BodyError> {
     }
     tensors.insert(
         "regressors.offsets".into(),
-        (Dtype::U32, vec![reg_off.len()], to_le(reg_off.iter().copied())),
+        (
+            Dtype::U32,
+            vec![reg_off.len()],
+            to_le(reg_off.iter().copied()),
+        ),
     );
     tensors.insert(
         "regressors.indices".into(),
-        (Dtype::U32, vec![reg_idx.len()], to_le(reg_idx.iter().copied())),
+        (
+            Dtype::U32,
+            vec![reg_idx.len()],
+            to_le(reg_idx.iter().copied()),
+        ),
     );
 
     for dir in TARGET_DIRS {
@@ -148,7 +168,11 @@ pub fn convert_assets(mpfb2: &Path, out: &Path) -> Result<(), BodyError> {
             );
             tensors.insert(
                 format!("target/{name}/delta"),
-                (Dtype::I16, vec![index.len(), 3], to_le(delta.iter().copied())),
+                (
+                    Dtype::I16,
+                    vec![index.len(), 3],
+                    to_le(delta.iter().copied()),
+                ),
             );
         }
     }

@@ -424,9 +424,7 @@ impl HeMesh {
             }
         };
         let keep_v: Vec<usize> = (0..self.vdel.len()).filter(|&v| !self.vdel[v]).collect();
-        let keep_h: Vec<usize> = (0..self.to.len())
-            .filter(|&h| !self.edel[h >> 1])
-            .collect();
+        let keep_h: Vec<usize> = (0..self.to.len()).filter(|&h| !self.edel[h >> 1]).collect();
         let keep_f: Vec<usize> = (0..self.fdel.len()).filter(|&f| !self.fdel[f]).collect();
         self.pos = keep_v.iter().map(|&v| self.pos[v]).collect();
         self.tag = keep_v.iter().map(|&v| self.tag[v]).collect();
@@ -464,8 +462,7 @@ impl HeMesh {
                 continue;
             }
             let (n, p) = (self.next[h as usize], self.prev[h as usize]);
-            if n >= nh || p >= nh || self.edel[(n >> 1) as usize] || self.edel[(p >> 1) as usize]
-            {
+            if n >= nh || p >= nh || self.edel[(n >> 1) as usize] || self.edel[(p >> 1) as usize] {
                 return Err(format!("half-edge {h}: dangling next/prev"));
             }
             if self.prev[n as usize] != h || self.next[p as usize] != h {
@@ -513,7 +510,9 @@ impl HeMesh {
             }
             let nb = out.iter().filter(|&&x| self.is_boundary_he(x)).count();
             if nb > 1 || (nb == 1 && !self.is_boundary_he(h)) {
-                return Err(format!("vertex {v}: {nb} boundary half-edges, vout not one"));
+                return Err(format!(
+                    "vertex {v}: {nb} boundary half-edges, vout not one"
+                ));
             }
         }
         Ok(())
@@ -584,7 +583,9 @@ mod tests {
             let mut h = he(&m);
             let mut seed = 12345u64;
             let mut rnd = |n: usize| {
-                seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                seed = seed
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
                 (seed >> 33) as usize % n
             };
             let mut done = [0usize; 3];
@@ -611,11 +612,9 @@ mod tests {
                             done[1] += 1;
                         }
                     }
-                    2 => {
-                        if topo_collapse_ok(&h, 2 * e) {
-                            h.collapse(2 * e);
-                            done[2] += 1;
-                        }
+                    2 if topo_collapse_ok(&h, 2 * e) => {
+                        h.collapse(2 * e);
+                        done[2] += 1;
                     }
                     _ => {}
                 }

@@ -2,20 +2,34 @@
 //! approach to multiresolution modeling" (SGP 2004), and a mesh quality report.
 //!
 //! [`isotropic_remesh`] repeats, `iterations` times:
-//! 1. split every edge longer than 4/3 L at its midpoint;
-//! 2. collapse every edge shorter than 4/5 L unless that would create an edge longer than
-//!    4/3 L, turn a face over, break manifoldness, or change the boundary topology;
-//! 3. flip edges whose flip brings vertex valences closer to 6 (4 on a boundary);
-//! 4. tangential relaxation: every vertex moves toward the centroid of its neighbours within
-//!    its tangent plane;
-//! 5. projection of every vertex back onto the input surface (closest point through a BVH).
+//! 1. split every edge longer than 4/3 L at its midpoint (until none is);
+//! 2. collapse every edge shorter than 4/5 L into its midpoint (into the constrained end when
+//!    one end is on the boundary or a corner) unless that would create an edge longer than
+//!    4/3 L, turn a face by more than 45 degrees, break manifoldness (link condition), or
+//!    change the boundary topology (a boundary vertex only merges with its loop neighbour, an
+//!    edge joining two boundary vertices across the surface is never collapsed, a loop keeps
+//!    three vertices);
+//! 3. flip interior edges whose flip brings the valences of its four vertices closer to 6 (4
+//!    on a boundary), unless it turns a face by more than 45 degrees or puts a long edge
+//!    (over 4/3 L) at the boundary;
+//! 4. tangential relaxation: every vertex moves to the (area-weighted or uniform) centroid of
+//!    its neighbours, projected onto its tangent plane;
+//! 5. projection of every interior vertex back onto the input surface (closest point through
+//!    a BVH).
+//!
+//! and finally flips edges of triangles with an angle under 25 degrees where that raises the
+//! smallest angle (Delaunay criterion). The mean edge length comes out within a few percent of
+//! L, the 5th and 95th percentiles typically near 0.85 L and 1.17 L.
 //!
 //! Boundaries: every input boundary loop stays one loop (so the genus and the number of loops
 //! are kept), resampled to about L. Boundary vertices live on the input boundary polyline,
-//! addressed by arc length: splits insert them at the arc-length midpoint, relaxation moves them
-//! to the midpoint of their two loop neighbours, so openings keep their exact shape and no
-//! boundary vertex ever passes another. Boundary vertices where the input loop turns by more
-//! than [`RemeshOptions::corner_angle_deg`] are kept as they are.
+//! addressed by arc length (in f64): splits and collapses place them at arc-length midpoints,
+//! relaxation moves them to the midpoint of their two loop neighbours, so openings keep their
+//! exact shape and no boundary vertex ever passes another. Boundary vertices where the input
+//! loop turns by more than [`RemeshOptions::corner_angle_deg`] are kept as they are. The
+//! output boundary is as smooth as the input's: smooth jagged openings first (for example
+//! [`crate::smooth::Smoother`] with interior vertices pinned and
+//! [`crate::smooth::BoundarySmoothing::AlongLoop`]).
 //!
 //! The result records, for each new vertex, an input face and barycentric weights
 //! ([`Remeshed::source_face`], [`Remeshed::source_bary`]) so attributes such as skinning
@@ -45,7 +59,7 @@ pub enum BoundaryMode {
     /// move): use when the boundary must match another mesh.
     Fixed,
     /// Boundary edges are split and collapsed toward L (new vertices on the input boundary
-    /// polyline) but surviving boundary vertices do not move.
+    /// polyline, at arc-length midpoints) but relaxation does not move boundary vertices.
     Resample,
     /// As `Resample`, and boundary vertices also slide along the input boundary polyline
     /// during relaxation, giving evenly spaced boundary vertices (the default).
@@ -67,7 +81,7 @@ pub enum Relaxation {
 /// Options of [`isotropic_remesh`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RemeshOptions {
-    /// Target edge length L (metres); edges end up mostly within [0.8 L, 1.33 L].
+    /// Target edge length L (metres); the output's mean edge length comes out close to L.
     pub target_edge_length: f32,
     /// Number of split / collapse / flip / relax / project iterations (default 8).
     pub iterations: u32,
@@ -171,6 +185,9 @@ impl Remeshed {
     }
 }
 
+/// Triangles with an angle below this (degrees) get a last Delaunay flip where that helps.
+const SLIVER_ANGLE_DEG: f32 = 25.0;
+
 /// Largest number of output faces [`isotropic_remesh`] accepts to produce (estimated from the
 /// surface area and L before starting).
 pub const MAX_REMESH_FACES: f64 = 5.0e7;
@@ -196,7 +213,9 @@ pub fn isotropic_remesh(mesh: &TriMesh, opts: &RemeshOptions) -> Result<Remeshed
     }
     mesh.validate()?;
     if mesh.faces.is_empty() {
-        return Err(GeomError::InvalidInput("cannot remesh a mesh without faces".into()));
+        return Err(GeomError::InvalidInput(
+            "cannot remesh a mesh without faces".into(),
+        ));
     }
     let report = check_manifold(mesh.vertices.len(), &mesh.faces)?;
     if !report.is_ok() {
@@ -211,17 +230,25 @@ pub fn isotropic_remesh(mesh: &TriMesh, opts: &RemeshOptions) -> Result<Remeshed
         )));
     }
     // Drop unreferenced vertices; faces keep their indices in the input (for the sources).
-    let mut remap = vec![u32::MAX; mesh.vertices.len()];
-    let mut pos = Vec::new();
+    let mut used = vec![false; mesh.vertices.len()];
     for f in &mesh.faces {
         for &v in f {
-            if remap[v as usize] == u32::MAX {
-                remap[v as usize] = pos.len() as u32;
-                pos.push(mesh.vertices[v as usize]);
-            }
+            used[v as usize] = true;
         }
     }
-    let faces: Vec<[u32; 3]> = mesh.faces.iter().map(|f| f.map(|v| remap[v as usize])).collect();
+    let mut remap = vec![u32::MAX; mesh.vertices.len()];
+    let mut pos = Vec::new();
+    for (v, &u) in used.iter().enumerate() {
+        if u {
+            remap[v] = pos.len() as u32;
+            pos.push(mesh.vertices[v]);
+        }
+    }
+    let faces: Vec<[u32; 3]> = mesh
+        .faces
+        .iter()
+        .map(|f| f.map(|v| remap[v as usize]))
+        .collect();
     let topo = EdgeTopology::new(pos.len(), &faces)?;
     let loops = boundary_loops(pos.len(), &faces)?;
     let proj = Projector::new(&pos, &faces, &topo, &loops)?;
@@ -254,6 +281,9 @@ pub fn isotropic_remesh(mesh: &TriMesh, opts: &RemeshOptions) -> Result<Remeshed
             r.project();
         }
         r.m.compact();
+    }
+    if opts.iterations > 0 {
+        r.flip_slivers(SLIVER_ANGLE_DEG, 3);
     }
     let (source_face, source_bary) = r.sources();
     let faces = r.m.faces();

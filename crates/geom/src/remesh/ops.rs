@@ -108,7 +108,9 @@ impl<'a> Remesher<'a> {
                 self.m.split_edge(e, line.point(s), tag);
                 self.loop_len[ta.lp as usize] += 1;
             } else {
-                let p = 0.5 * (self.m.pos[self.m.from(2 * e) as usize] + self.m.pos[self.m.to[2 * e as usize] as usize]);
+                let p = 0.5
+                    * (self.m.pos[self.m.from(2 * e) as usize]
+                        + self.m.pos[self.m.to[2 * e as usize] as usize]);
                 self.m.split_edge(e, p, VTag::INTERIOR);
             }
             count += 1;
@@ -118,10 +120,36 @@ impl<'a> Remesher<'a> {
         count
     }
 
-    /// Whether collapsing `h` (removing its source v0 into its target v1, which does not move)
-    /// keeps the mesh manifold with the same boundary loops, flips no face and creates no
-    /// edge longer than `high`.
-    fn collapse_ok(&mut self, h: u32) -> bool {
+    /// Where the vertex left by collapsing `h` (v0 -> v1) goes: the midpoint of two interior
+    /// vertices, the arc-length midpoint on the loop of two free boundary vertices, else v1
+    /// itself (a boundary vertex absorbing an interior one, or a locked corner). Returns the
+    /// position and, on a loop, the arc length.
+    fn collapse_target(&self, h: u32) -> (Vec3, Option<f64>) {
+        let m = &self.m;
+        let (v0, v1) = (m.from(h), m.to[h as usize]);
+        let (b0, b1) = (m.is_boundary_vertex(v0), m.is_boundary_vertex(v1));
+        let p1 = m.pos[v1 as usize];
+        if !b0 && !b1 {
+            return (0.5 * (m.pos[v0 as usize] + p1), None);
+        }
+        let t1 = m.tag[v1 as usize];
+        if !b0 || !b1 || t1.locked {
+            // (A boundary v0 into an interior v1 is refused by `collapse_ok`.)
+            return (p1, Some(t1.s).filter(|_| b1));
+        }
+        // Both on the loop, along a boundary edge (checked by the caller).
+        let hb = if m.is_boundary_he(h) { h } else { h ^ 1 };
+        let (a, b) = (m.from(hb), m.to[hb as usize]);
+        let line = &self.proj.loops[t1.lp as usize];
+        let (sa, sb) = (m.tag[a as usize].s, m.tag[b as usize].s);
+        let s = line.wrap(sb + 0.5 * line.wrap(sa - sb));
+        (line.point(s), Some(s))
+    }
+
+    /// Whether collapsing `h` (removing its source v0 into its target v1, which moves to `p`)
+    /// keeps the mesh manifold with the same boundary loops, turns no face by more than 45
+    /// degrees and creates no edge longer than `high`.
+    fn collapse_ok(&mut self, h: u32, p: Vec3) -> bool {
         let m = &self.m;
         let o = h ^ 1;
         let (v0, v1) = (m.from(h), m.to[h as usize]);
@@ -174,24 +202,29 @@ impl<'a> Remesher<'a> {
         if common != usize::from(vl != NONE) + usize::from(vr != NONE) {
             return false;
         }
-        // Geometry: short enough edges, no face turned over.
-        let (p0, p1) = (m.pos[v0 as usize], m.pos[v1 as usize]);
+        // Geometry: short enough edges, no face turned over, around both ends.
         let high2 = self.high * self.high;
         let (fh, fo) = (m.hface[h as usize], m.hface[o as usize]);
-        for x in m.outgoing(v0) {
-            let w = m.to[x as usize];
-            if w == v1 {
-                continue;
+        for (v, other) in [(v0, v1), (v1, v0)] {
+            let pv = m.pos[v as usize];
+            if v == v1 && pv == p {
+                break;
             }
-            let pw = m.pos[w as usize];
-            if p1.distance_squared(pw) > high2 {
-                return false;
-            }
-            let f = m.hface[x as usize];
-            if f != NONE && f != fh && f != fo {
-                let py = m.pos[m.opposite_vertex(x) as usize];
-                if !normal_ok((pw - p0).cross(py - p0), (pw - p1).cross(py - p1)) {
+            for x in m.outgoing(v) {
+                let w = m.to[x as usize];
+                if w == other {
+                    continue;
+                }
+                let pw = m.pos[w as usize];
+                if p.distance_squared(pw) > high2 {
                     return false;
+                }
+                let f = m.hface[x as usize];
+                if f != NONE && f != fh && f != fo {
+                    let py = m.pos[m.opposite_vertex(x) as usize];
+                    if !normal_ok((pw - pv).cross(py - pv), (pw - p).cross(py - p)) {
+                        return false;
+                    }
                 }
             }
         }
@@ -210,18 +243,21 @@ impl<'a> Remesher<'a> {
                 if self.m.edel[e as usize] || self.len2(2 * e) >= low2 {
                     continue;
                 }
-                let h = if self.collapse_ok(2 * e) {
-                    2 * e
-                } else if self.collapse_ok(2 * e + 1) {
-                    2 * e + 1
-                } else {
+                let Some((h, (p, s))) = [2 * e, 2 * e + 1].into_iter().find_map(|h| {
+                    let t = self.collapse_target(h);
+                    self.collapse_ok(h, t.0).then_some((h, t))
+                }) else {
                     continue;
                 };
-                let v0 = self.m.from(h);
+                let (v0, v1) = (self.m.from(h), self.m.to[h as usize]);
                 if self.m.is_boundary_vertex(v0) {
                     self.loop_len[self.m.tag[v0 as usize].lp as usize] -= 1;
                 }
                 self.m.collapse(h);
+                self.m.pos[v1 as usize] = p;
+                if let Some(s) = s {
+                    self.m.tag[v1 as usize].s = s;
+                }
                 count += 1;
             }
             total += count;
@@ -233,10 +269,39 @@ impl<'a> Remesher<'a> {
         total
     }
 
+    /// The diamond `[a, b, c, d]` of interior edge `e` (faces `(a, b, c)` and `(b, a, d)`)
+    /// when flipping it to c-d is allowed topologically (c-d not an edge yet, a and b keep
+    /// enough faces) and turns no face by more than 45 degrees; `None` otherwise.
+    fn flippable(&self, e: u32) -> Option<[u32; 4]> {
+        let m = &self.m;
+        if m.edel[e as usize] || m.is_boundary_edge(e) {
+            return None;
+        }
+        let (h, o) = (2 * e, 2 * e + 1);
+        let vs = [
+            m.from(h),
+            m.to[h as usize],
+            m.opposite_vertex(h),
+            m.opposite_vertex(o),
+        ];
+        for v in &vs[..2] {
+            if m.valence(*v) < if m.is_boundary_vertex(*v) { 3 } else { 4 } {
+                return None;
+            }
+        }
+        if m.find_halfedge(vs[2], vs[3]).is_some() {
+            return None;
+        }
+        let [pa, pb, pc, pd] = vs.map(|v| m.pos[v as usize]);
+        let (n1, n2) = ((pb - pa).cross(pc - pa), (pa - pb).cross(pd - pb));
+        let (m1, m2) = ((pd - pc).cross(pb - pc), (pc - pd).cross(pa - pd));
+        let ok = normal_ok(n1, m1) && normal_ok(n2, m1) && normal_ok(n1, m2) && normal_ok(n2, m2);
+        ok.then_some(vs)
+    }
+
     /// Flips interior edges where that brings the four vertices' valences closer to 6 (4 on a
-    /// boundary) in total absolute deviation, unless the flip would duplicate an edge, leave a
-    /// vertex with too few faces, or turn a face by more than 45 degrees. Returns the number
-    /// of flips.
+    /// boundary) in total absolute deviation, if [`Remesher::flippable`] and, where the new
+    /// edge touches the boundary, it is no longer than `high`. Returns the number of flips.
     pub fn equalize_valences(&mut self) -> usize {
         let mut count = 0;
         for e in 0..self.m.n_edges() as u32 {
@@ -245,28 +310,23 @@ impl<'a> Remesher<'a> {
                 continue;
             }
             let (h, o) = (2 * e, 2 * e + 1);
-            let (a, b) = (m.from(h), m.to[h as usize]);
-            let (c, d) = (m.opposite_vertex(h), m.opposite_vertex(o));
-            let vs = [a, b, c, d];
+            let vs = [
+                m.from(h),
+                m.to[h as usize],
+                m.opposite_vertex(h),
+                m.opposite_vertex(o),
+            ];
             let bnd = vs.map(|v| m.is_boundary_vertex(v));
             let val = vs.map(|v| m.valence(v) as i32);
             let dev = |k: usize, delta: i32| (val[k] + delta - target_valence(bnd[k])).abs();
             let before: i32 = (0..4).map(|k| dev(k, 0)).sum();
             let after = dev(0, -1) + dev(1, -1) + dev(2, 1) + dev(3, 1);
-            if after >= before {
+            if after >= before || self.flippable(e).is_none() {
                 continue;
             }
-            if val[0] < if bnd[0] { 3 } else { 4 } || val[1] < if bnd[1] { 3 } else { 4 } {
-                continue;
-            }
-            if m.find_halfedge(c, d).is_some() {
-                continue;
-            }
-            let [pa, pb, pc, pd] = vs.map(|v| m.pos[v as usize]);
-            let (n1, n2) = ((pb - pa).cross(pc - pa), (pa - pb).cross(pd - pb));
-            let (m1, m2) = ((pd - pc).cross(pb - pc), (pc - pd).cross(pa - pd));
-            if !(normal_ok(n1, m1) && normal_ok(n2, m1) && normal_ok(n1, m2) && normal_ok(n2, m2))
-            {
+            // A new edge at the boundary must not be long: nothing smooths it out there.
+            let (pc, pd) = (m.pos[vs[2] as usize], m.pos[vs[3] as usize]);
+            if (bnd[2] || bnd[3]) && pc.distance_squared(pd) > self.high * self.high {
                 continue;
             }
             self.m.flip(e);
@@ -275,4 +335,45 @@ impl<'a> Remesher<'a> {
         self.stats.flips += count;
         count
     }
+
+    /// Flips the interior edges of triangles with an angle below `min_angle_deg` where that
+    /// raises the smaller of the two triangles' smallest angles (the Delaunay criterion,
+    /// restricted to bad triangles so valences stay regular elsewhere); repeats while it makes
+    /// progress, at most `max_sweeps` times. Returns the number of flips.
+    pub fn flip_slivers(&mut self, min_angle_deg: f32, max_sweeps: usize) -> usize {
+        let mut total = 0;
+        for _ in 0..max_sweeps {
+            let mut count = 0;
+            for e in 0..self.m.n_edges() as u32 {
+                let Some(vs) = self.flippable(e) else {
+                    continue;
+                };
+                let [pa, pb, pc, pd] = vs.map(|v| self.m.pos[v as usize]);
+                let before = min_angle(pa, pb, pc).min(min_angle(pb, pa, pd));
+                let after = min_angle(pc, pd, pb).min(min_angle(pd, pc, pa));
+                if before < min_angle_deg && after > before + 1.0 {
+                    self.m.flip(e);
+                    count += 1;
+                }
+            }
+            total += count;
+            if count == 0 {
+                break;
+            }
+        }
+        self.stats.flips += total;
+        total
+    }
+}
+
+/// Smallest angle (degrees) of triangle `(a, b, c)`; 0 when degenerate.
+fn min_angle(a: Vec3, b: Vec3, c: Vec3) -> f32 {
+    let ang = |p: Vec3, q: Vec3, r: Vec3| {
+        let (u, v) = (q - p, r - p);
+        u.cross(v).length().atan2(u.dot(v))
+    };
+    ang(a, b, c)
+        .min(ang(b, c, a))
+        .min(ang(c, a, b))
+        .to_degrees()
 }

@@ -181,7 +181,10 @@ mod tests {
         assert_eq!(q.valence_histogram, vec![0, 0, 0, 0, 0, 0, 4]);
         assert_eq!(q.edge_min, 0.5);
         assert!(q.to_string().contains("valence 6: 100.0%"), "{q}");
-        assert_eq!(mesh_quality(&TriMesh::default()).unwrap(), MeshQuality::default());
+        assert_eq!(
+            mesh_quality(&TriMesh::default()).unwrap(),
+            MeshQuality::default()
+        );
         assert!(mesh_quality(&TriMesh::new(vec![], vec![[0, 1, 2]])).is_err());
     }
 }
