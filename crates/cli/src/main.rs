@@ -9,6 +9,8 @@ mod output;
 mod pose_args;
 mod pose_cmd;
 mod shape_args;
+mod simulate_cmd;
+mod simulate_sheet;
 
 use clap::{Parser, Subcommand};
 
@@ -36,6 +38,8 @@ enum Cmd {
     /// Pose files: convert CMU ASF/AMC clips to BVH.
     #[command(subcommand)]
     Pose(pose_cmd::PoseCmd),
+    /// Drape a garment template on a body with the cloth simulator.
+    Simulate(simulate_cmd::SimulateArgs),
     /// Benchmarks measured in one run, reported with ratios to a reference.
     #[command(subcommand)]
     Bench(bench_cmd::BenchCmd),
@@ -49,6 +53,7 @@ fn main() {
         Some(Cmd::Body(a)) => body_cmd::run(a),
         Some(Cmd::Garment(c)) => garment_cmd::run(c),
         Some(Cmd::Pose(c)) => pose_cmd::run(c),
+        Some(Cmd::Simulate(a)) => simulate_cmd::run(a),
         Some(Cmd::Bench(c)) => bench_cmd::run(c),
     };
     if let Err(e) = result {

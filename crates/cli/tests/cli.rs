@@ -294,3 +294,50 @@ fn garment_commands_refuse_bad_input() {
     let err = fails(&["garment", "warp", "--template", s(&p("bad.garment"))]);
     assert!(err.contains("bad.garment"), "{err}");
 }
+
+#[test]
+fn simulate_drapes_a_template_and_reports_statistics() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    ok(&[
+        "garment",
+        "make",
+        "tshirt",
+        "--edge",
+        "0.03",
+        "--out",
+        s(&p("t.garment")),
+    ]);
+    // The template body at rest: the shirt settles where it was fitted.
+    let (out, stats, frames) = (p("d.obj"), p("d.json"), p("frames"));
+    ok(&[
+        "simulate",
+        "--template",
+        s(&p("t.garment")),
+        "--out",
+        s(&out),
+        "--stats",
+        s(&stats),
+        "--frames",
+        s(&frames),
+        "--frames-every",
+        "50",
+    ]);
+    let draped = geom::io::read_mesh(&out).unwrap();
+    let template = garment::GarmentTemplate::load(&p("t.garment")).unwrap();
+    assert_eq!(
+        draped.faces, template.mesh.faces,
+        "every output vertex is its template vertex"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    assert_eq!(json["converged"], true, "{json}");
+    assert!(
+        json["max_penetration_m"].as_f64().unwrap() <= 0.001,
+        "{json}"
+    );
+    assert!(frames.join("garment_0000.obj").is_file() && frames.join("body_0050.obj").is_file());
+    let err = fails(&["simulate", "--out", s(&p("x.obj"))]);
+    assert!(err.contains("--template"), "{err}");
+    assert!(!p("x.obj").exists());
+}

@@ -1,0 +1,251 @@
+//! The drape driver: a garment template starts on the template body; the body morphs
+//! into the target shape, then moves into the target pose (every joint slerped from
+//! the rest pose), the cloth following by contact and friction; then the cloth settles
+//! until its kinetic energy falls below a threshold or the step budget runs out. Every
+//! output vertex is the template vertex of the same index.
+//!
+//! The yaw of the target's root (a turn about the vertical) changes nothing physical, so
+//! the animation runs without it and the result is turned at the end: garments are not
+//! dragged around by a body spinning in place.
+
+use std::time::Instant;
+
+use body::{Pose, ShapedBody, Skinning};
+use garment::warp::SurfaceAnchors;
+use garment::GarmentTemplate;
+use geom::TriMesh;
+use glam::{Quat, Vec3};
+
+use crate::stats::DrapeStats;
+use crate::{BodyCollider, ClothParams, ClothSim, SimError};
+
+/// Settings of a drape.
+#[derive(Clone, Debug)]
+pub struct DrapeOptions {
+    /// The cloth material and solver settings.
+    pub cloth: ClothParams,
+    /// Steps over which the body morphs from the template shape to the target shape.
+    pub morph_steps: u32,
+    /// Steps over which the body moves from the rest pose to the target pose.
+    pub pose_steps: u32,
+    /// Most steps spent settling after the animation.
+    pub max_settle_steps: u32,
+    /// The cloth is at rest when its root-mean-square speed falls below this, m/s.
+    pub rest_speed: f32,
+    /// A drape whose cloth moves faster than this (root-mean-square, m/s) has diverged.
+    pub explode_speed: f32,
+    /// A drape that leaves a garment vertex deeper than this inside the body failed, m.
+    pub max_penetration: f32,
+    /// How the body is skinned during the animation.
+    pub skinning: Skinning,
+    /// Grade the garment to the target body, as a shop sells sizes: the cloth's rest
+    /// lengths are those of the template carried onto the target's rest shape by its
+    /// surface anchors, so a garment fits a larger body as it fits the template body.
+    /// Without it a small template is stretched over a large body.
+    pub grade: bool,
+}
+
+impl Default for DrapeOptions {
+    fn default() -> Self {
+        Self {
+            cloth: ClothParams::default(),
+            morph_steps: 40,
+            pose_steps: 60,
+            max_settle_steps: 400,
+            rest_speed: 0.005,
+            explode_speed: 30.0,
+            max_penetration: 0.001,
+            skinning: Skinning::Dqs,
+            grade: true,
+        }
+    }
+}
+
+/// Sees every step of a drape: `(step, garment [N], body [V])`, metres.
+pub type FrameObserver<'a> = dyn FnMut(u32, &[Vec3], &[Vec3]) + 'a;
+
+/// A finished drape: the garment (template topology) and the body it rests on.
+#[derive(Clone, Debug)]
+pub struct Drape {
+    /// The draped garment: the template's topology, metres.
+    pub garment: TriMesh,
+    /// The body in the target shape and pose.
+    pub body: TriMesh,
+    /// What the drape took and reached.
+    pub stats: DrapeStats,
+}
+
+/// The root's turn about the vertical and the rest of its rotation: `world = yaw * tilt`.
+fn split_yaw(world: Quat) -> (Quat, Quat) {
+    let twist = Quat::from_xyzw(0.0, world.y, 0.0, world.w);
+    let yaw = if twist.length_squared() < 1e-12 {
+        Quat::IDENTITY
+    } else {
+        twist.normalize()
+    };
+    (yaw, (yaw.inverse() * world).normalize())
+}
+
+/// Drapes `template` (fitted on `template_body`, its rest shape) onto `target` in `pose`.
+/// `on_frame(step, garment, body)` sees every step (for recording the animation).
+/// Errors if the simulation diverges (NaN, exploding speed) or leaves cloth inside the
+/// body; the error says which and when.
+pub fn drape(
+    template: &GarmentTemplate,
+    template_body: &ShapedBody,
+    target: &ShapedBody,
+    pose: &Pose,
+    opts: &DrapeOptions,
+    on_frame: &mut FrameObserver<'_>,
+) -> Result<Drape, SimError> {
+    let start = Instant::now();
+    if template_body.mesh.vertices.len() != target.mesh.vertices.len()
+        || template.mesh.vertices.is_empty()
+    {
+        return Err(SimError::InvalidInput(
+            "the target body does not share the template body's mesh".into(),
+        ));
+    }
+    if pose.rotations.len() != target.rig.len()
+        || !pose.root_translation.is_finite()
+        || pose.rotations.iter().any(|q| !q.is_finite())
+    {
+        return Err(SimError::InvalidInput(
+            "the pose does not fit the body's rig or holds NaN".into(),
+        ));
+    }
+    let (yaw, mut calm) = remove_root_yaw(target, pose);
+    calm.rotations.iter_mut().for_each(|q| *q = q.normalize());
+    let mut sim = if opts.grade {
+        let anchors = SurfaceAnchors::new(&template.mesh, &template_body.mesh)
+            .map_err(|e| SimError::InvalidInput(e.to_string()))?;
+        let graded = TriMesh {
+            vertices: anchors.place(&target.mesh),
+            faces: template.mesh.faces.clone(),
+        };
+        let mut sim = ClothSim::new(&graded, &opts.cloth)?;
+        sim.set_positions(&template.mesh.vertices)?;
+        sim
+    } else {
+        ClothSim::new(&template.mesh, &opts.cloth)?
+    };
+    let mut collider = BodyCollider::new(&template_body.mesh, opts.cloth.thickness)?;
+    let mass = cloth_mass(&template.mesh, opts.cloth.density);
+    let rms_speed = |sim: &ClothSim| (2.0 * sim.kinetic_energy() / mass).sqrt();
+    let mut step = 0u32;
+    let mut advance = |sim: &mut ClothSim,
+                       collider: &mut BodyCollider,
+                       body: &[Vec3],
+                       step: &mut u32|
+     -> Result<(), SimError> {
+        collider.move_to(body)?;
+        sim.step(Some(collider))?;
+        let speed = rms_speed(sim);
+        if !speed.is_finite() || speed > opts.explode_speed {
+            return Err(SimError::Diverged(format!(
+                "cloth speed {speed:.1} m/s at step {step}"
+            )));
+        }
+        on_frame(*step, sim.positions(), body);
+        *step += 1;
+        Ok(())
+    };
+    // Shape: the body's rest mesh morphs linearly from the template shape to the target's.
+    for k in 1..=opts.morph_steps {
+        let t = k as f32 / opts.morph_steps as f32;
+        let body: Vec<Vec3> = template_body
+            .mesh
+            .vertices
+            .iter()
+            .zip(&target.mesh.vertices)
+            .map(|(a, b)| a.lerp(*b, t))
+            .collect();
+        advance(&mut sim, &mut collider, &body, &mut step)?;
+    }
+    // Pose: every joint slerps from rest to the target (root yaw left out).
+    let rest = Pose::identity(target.rig.len());
+    let mut body = target.mesh.vertices.clone();
+    for k in 1..=opts.pose_steps {
+        let t = k as f32 / opts.pose_steps as f32;
+        body = target
+            .posed(&rest.slerp(&calm, t), opts.skinning)
+            .map_err(|e| SimError::InvalidInput(e.to_string()))?
+            .vertices;
+        advance(&mut sim, &mut collider, &body, &mut step)?;
+    }
+    let animation_steps = step;
+    let mut converged = false;
+    while step - animation_steps < opts.max_settle_steps {
+        advance(&mut sim, &mut collider, &body, &mut step)?;
+        if rms_speed(&sim) < opts.rest_speed {
+            converged = true;
+            break;
+        }
+    }
+    let mut stats = DrapeStats {
+        animation_steps,
+        settle_steps: step - animation_steps,
+        final_kinetic_energy: sim.kinetic_energy(),
+        converged,
+        ..Default::default()
+    };
+    stats.measure(
+        &collider.penetration_depths(sim.positions()),
+        &sim.strains(),
+    );
+    if stats.max_penetration_m > opts.max_penetration {
+        return Err(SimError::Diverged(format!(
+            "cloth left {:.2} mm inside the body (at most {:.2} mm allowed)",
+            stats.max_penetration_m * 1e3,
+            opts.max_penetration * 1e3
+        )));
+    }
+    // Turn the result by the root's yaw about the vertical through the root.
+    let centre = target.rig.bones[0].head + pose.root_translation;
+    let turn = |p: &Vec3| yaw * (*p - centre) + centre;
+    stats.wall_time_s = start.elapsed().as_secs_f64();
+    Ok(Drape {
+        garment: TriMesh {
+            vertices: sim.positions().iter().map(turn).collect(),
+            faces: template.mesh.faces.clone(),
+        },
+        body: TriMesh {
+            vertices: body.iter().map(turn).collect(),
+            faces: target.mesh.faces.clone(),
+        },
+        stats,
+    })
+}
+
+/// The root's yaw and `pose` with the root's world rotation reduced to its tilt.
+fn remove_root_yaw(target: &ShapedBody, pose: &Pose) -> (Quat, Pose) {
+    let root = &target.rig.bones[0];
+    let world = root.frame * pose.rotations[0] * root.frame.inverse();
+    let (yaw, tilt) = split_yaw(world);
+    let mut calm = pose.clone();
+    calm.rotations[0] = root.frame.inverse() * tilt * root.frame;
+    (yaw, calm)
+}
+
+/// Total mass of a cloth mesh of `density` kg/m^2.
+fn cloth_mass(mesh: &TriMesh, density: f32) -> f32 {
+    geom::normals::face_areas(&mesh.vertices, &mesh.faces)
+        .iter()
+        .sum::<f32>()
+        * density
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn yaw_split_recomposes_and_is_vertical() {
+        let q = Quat::from_rotation_y(1.1) * Quat::from_rotation_x(0.4);
+        let (yaw, tilt) = split_yaw(q);
+        assert!((yaw * tilt).angle_between(q) < 1e-5);
+        let axis = yaw.to_axis_angle().0;
+        assert!(axis.cross(Vec3::Y).length() < 1e-4);
+        assert!((yaw.to_axis_angle().1 - 1.1).abs() < 0.05);
+    }
+}

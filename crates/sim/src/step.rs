@@ -1,0 +1,301 @@
+//! One time step of [`ClothSim`].
+//!
+//! A step of length `h`:
+//! 1. **Contacts.** Every free vertex within thickness + margin of the body at the start of
+//!    the step (closest point through the BVH) gets a [`Contact`]: the body's tangent plane
+//!    at the end of the step, and an anchor, its start position carried by the motion of its
+//!    body point (a barycentric attachment), so a fast body carries the cloth it touches
+//!    instead of leaving it behind or passing through it.
+//! 2. **Prediction** `y = x + d + h (v - u) / (1 + damping h) + h^2 g` (`d`: the body's
+//!    displacement this step at the contact, `u`: the body velocity there last step; both
+//!    zero away from the body).
+//! 3. **Active contacts**: those predicted to press into the body or pressed at the end of
+//!    the last step. Their weights join the system matrix, which is refactorised
+//!    numerically when enough of them changed (a few late ones are pushed out after every
+//!    iteration meanwhile; a few stale ones act as a zero-force proximal term).
+//! 4. **Projective dynamics** iterations from `y` (see [`crate::pd`]), contacts and Coulomb
+//!    friction inside the local step.
+//! 5. **Velocities** `(x_new - x)/h`; then every vertex inside the body or closer than half
+//!    the thickness is projected out along the surface normal (to half the thickness: the
+//!    contact constraints keep resting cloth at the full thickness, and pushing farther
+//!    each step would fight them and stretch the cloth), losing its inward velocity
+//!    relative to the body, with Coulomb friction on the tangential part.
+
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+
+use crate::cloth::{ClothSim, StepInfo, MAX_SPEED};
+use crate::collide::BodyCollider;
+use crate::error::{Result, SimError};
+use crate::pd::{Contact, PdProblem, MIN_PAR};
+
+/// After the solve, vertices closer to the body than this fraction of the thickness are
+/// projected out to it.
+const PROJECT_FRACTION: f32 = 0.5;
+/// Refactorise when more than this fraction of the free vertices became active contacts
+/// missing from the factored matrix...
+const REFACTOR_MISSING: usize = 200;
+/// ...or when any did and the factor is this many steps old...
+const REFACTOR_AGE: u32 = 4;
+/// ...or when more than this fraction of the free vertices hold a stale contact weight.
+const REFACTOR_STALE: usize = 50;
+
+impl ClothSim {
+    /// Advances the simulation by one time step `params().dt`, colliding with `collider` if
+    /// given (the body moves linearly from where it was at the previous step to where the
+    /// last [`BodyCollider::move_to`] put it; the collider then keeps that place as its
+    /// start).
+    ///
+    /// Fails with [`SimError::Diverged`] (naming the vertex) when a position becomes
+    /// non-finite or a speed exceeds [`MAX_SPEED`], and with [`SimError::Solver`] when a
+    /// factorisation fails; the cloth state is then left as it was before the step.
+    pub fn step(&mut self, collider: Option<&mut BodyCollider>) -> Result<StepInfo> {
+        let n = self.x.len();
+        let p = self.params;
+        let h = p.dt as f64;
+        let inv_h2 = 1.0 / (h * h);
+        let drag = 1.0 / (1.0 + p.damping as f64 * h);
+        let mut info = StepInfo::default();
+
+        // 1. Contacts at the start of the step.
+        let thick = p
+            .thickness
+            .max(collider.as_ref().map_or(0.0, |c| c.thickness()));
+        let reach = thick + p.contact_margin;
+        let mut contacts: Vec<Option<Contact>> = vec![None; n];
+        // Lower bound of each vertex's distance to the body at the start (metres).
+        let mut dist0 = vec![f32::INFINITY; n];
+        if let Some(c) = collider.as_deref() {
+            find_contacts(self, c, reach, &mut contacts, &mut dist0);
+        }
+        info.contacts = contacts.iter().filter(|c| c.is_some()).count();
+
+        // 2. Prediction.
+        let g = p.gravity.as_dvec3();
+        let y: Vec<DVec3> = (0..n)
+            .map(|i| {
+                if self.pinned[i] {
+                    return self.pin_target[i].as_dvec3();
+                }
+                let (carry, u) = match &contacts[i] {
+                    Some(c) => (c.carry, self.body_vel[i].as_dvec3()),
+                    None => (DVec3::ZERO, DVec3::ZERO),
+                };
+                let vrel = (self.v[i].as_dvec3() - u) * drag;
+                self.x[i].as_dvec3() + carry + h * vrel + h * h * g
+            })
+            .collect();
+
+        // 3. Active contacts; refactorise when the set changed enough.
+        let active: Vec<bool> = (0..n)
+            .map(|i| match &contacts[i] {
+                Some(c) => c.height(y[i]) < thick as f64 || self.last_force[i] > 0.0,
+                None => false,
+            })
+            .collect();
+        info.active_contacts = active.iter().filter(|&&a| a).count();
+        let nf = self.free.len();
+        let missing = (0..n).filter(|&i| active[i] && !self.factored[i]).count();
+        let stale = (0..n).filter(|&i| !active[i] && self.factored[i]).count();
+        let refactor = missing > nf / REFACTOR_MISSING
+            || (missing > 0 && self.steps_since_refactor >= REFACTOR_AGE)
+            || stale > nf / REFACTOR_STALE;
+        if refactor && self.solver.is_some() {
+            self.refactor(&active)?;
+            info.refactored = true;
+        } else {
+            self.steps_since_refactor = self.steps_since_refactor.saturating_add(1);
+        }
+
+        // 4. Projective dynamics, starting from the prediction without gravity: at rest the
+        // start is then the equilibrium itself, a fixed point of the iterations, so the rest
+        // state does not depend on how far the iterations converge.
+        let gh2 = h * h * g;
+        let mut xs: Vec<DVec3> = (0..n)
+            .map(|i| if self.pinned[i] { y[i] } else { y[i] - gh2 })
+            .collect();
+        if let Some(solver) = self.solver.as_ref() {
+            let problem = PdProblem {
+                cons: &self.cons,
+                free: &self.free,
+                pinned: &self.pinned,
+                y: &y,
+                inv_h2,
+                contact_w: &self.contact_w,
+                factored: &self.factored,
+                contacts: &contacts,
+                active: &active,
+                thick: thick as f64,
+                mu: p.friction as f64,
+            };
+            let change = problem.iterate(solver, p.iterations, p.chebyshev_rho as f64, &mut xs)?;
+            info.iterations = p.iterations;
+            info.last_change = change as f32;
+        }
+
+        // 5. Velocities and contact forces; friction for contacts the solve did not hold.
+        let mut x1: Vec<Vec3> = xs.iter().map(|p| p.as_vec3()).collect();
+        let mut v1: Vec<Vec3> = (0..n).map(|i| (x1[i] - self.x[i]) / p.dt).collect();
+        let mut force = vec![0.0f64; n];
+        for i in 0..n {
+            let (Some(c), true) = (&contacts[i], active[i]) else {
+                continue;
+            };
+            let depth = (thick as f64 - c.height(xs[i])).max(0.0);
+            if self.factored[i] {
+                force[i] = self.contact_w[i] * depth;
+            } else {
+                // Pushed out after each iteration: the force that stopped its prediction.
+                force[i] = self.cons.mass[i] * inv_h2 * c.normal.dot(xs[i] - y[i]).max(0.0);
+                let u = (c.carry / h).as_vec3();
+                let dvn = (force[i] * h / self.cons.mass[i]) as f32;
+                v1[i] = u + friction(v1[i] - u, c.normal.as_vec3(), p.friction * dvn);
+            }
+        }
+
+        // 6. Collision projection.
+        if let Some(c) = collider.as_deref() {
+            let fixes = project_out(self, c, &x1, &dist0, reach, thick * PROJECT_FRACTION);
+            info.projected = fixes.len();
+            for (i, target, nrm) in fixes {
+                let push = (target - x1[i]).length();
+                x1[i] = target;
+                let u = contacts[i].map_or(Vec3::ZERO, |c| (c.carry / h).as_vec3());
+                let mut vrel = v1[i] - u;
+                let vn = vrel.dot(nrm);
+                let mut dvn = push / p.dt;
+                if vn < 0.0 {
+                    vrel -= vn * nrm;
+                    dvn -= vn;
+                }
+                v1[i] = u + friction(vrel, nrm, p.friction * dvn);
+            }
+        }
+
+        // 7. Pinned vertices; blow-up check; commit.
+        for &i in &self.pin_list {
+            let i = i as usize;
+            x1[i] = self.pin_target[i];
+            v1[i] = (x1[i] - self.x[i]) / p.dt;
+        }
+        let mut max_speed2 = 0.0f32;
+        for i in 0..n {
+            let s2 = v1[i].length_squared();
+            if !x1[i].is_finite() || !s2.is_finite() || s2 > MAX_SPEED * MAX_SPEED {
+                return Err(SimError::Diverged(format!(
+                    "vertex {i} reached position {} with velocity {} (speed limit \
+                     {MAX_SPEED} m/s)",
+                    x1[i], v1[i]
+                )));
+            }
+            max_speed2 = max_speed2.max(s2);
+        }
+        for (u, c) in self.body_vel.iter_mut().zip(&contacts) {
+            *u = c.map_or(Vec3::ZERO, |c| (c.carry / h).as_vec3());
+        }
+        self.x = x1;
+        self.v = v1;
+        self.last_force = force;
+        if let Some(c) = collider {
+            c.commit();
+        }
+        info.kinetic_energy = self.kinetic_energy();
+        info.max_speed = max_speed2.sqrt();
+        Ok(info)
+    }
+}
+
+/// Fills `contacts` (`[N]`) for the free vertices of `sim` within `reach` of the body at the
+/// start of the step, and `dist0` (`[N]`) with a lower bound of every free vertex's distance
+/// to the body then (searched up to about twice the distance it can travel this step).
+fn find_contacts(
+    sim: &ClothSim,
+    c: &BodyCollider,
+    reach: f32,
+    contacts: &mut [Option<Contact>],
+    dist0: &mut [f32],
+) {
+    let p = &sim.params;
+    let max_disp = c.max_displacement();
+    let (x, v, pinned) = (&sim.x, &sim.v, &sim.pinned);
+    contacts
+        .par_iter_mut()
+        .zip(dist0.par_iter_mut())
+        .enumerate()
+        .with_min_len(MIN_PAR)
+        .for_each(|(i, (ct, d0))| {
+            if pinned[i] {
+                return;
+            }
+            let travel = v[i].length() * p.dt + p.gravity.length() * p.dt * p.dt;
+            let r = reach + 2.0 * (travel + max_disp);
+            match c.closest_prev(x[i], r) {
+                Some(hit) => {
+                    *d0 = hit.distance;
+                    if hit.distance <= reach {
+                        let (pt, nrm) = c.plane_cur(hit.face, hit.bary);
+                        let carry = c.displacement(hit.face, hit.bary);
+                        *ct = Some(Contact {
+                            carry: carry.as_dvec3(),
+                            point: pt.as_dvec3(),
+                            normal: nrm.as_dvec3(),
+                            anchor: (x[i] + carry).as_dvec3(),
+                        });
+                    }
+                }
+                None => *d0 = r,
+            }
+        });
+}
+
+/// The free vertices of `x1` (`[N]`) inside the body or closer to it than `to` (metres) at the
+/// end of the step, each with where it goes (`to` outside the surface) and the outward
+/// direction. Vertices with no surface within `reach` are outside unless they may have
+/// travelled farther than their start distance `dist0`, when the winding test decides.
+fn project_out(
+    sim: &ClothSim,
+    c: &BodyCollider,
+    x1: &[Vec3],
+    dist0: &[f32],
+    reach: f32,
+    to: f32,
+) -> Vec<(usize, Vec3, Vec3)> {
+    let max_disp = c.max_displacement();
+    let (x0, pinned) = (&sim.x, &sim.pinned);
+    (0..x1.len())
+        .into_par_iter()
+        .with_min_len(MIN_PAR)
+        .filter_map(|i| {
+            if pinned[i] {
+                return None;
+            }
+            let xi = x1[i];
+            let hit = match c.surface_within(xi, reach) {
+                Some(hit) => hit,
+                None => {
+                    let travel = (xi - x0[i]).length() + max_disp;
+                    if travel < dist0[i] || !c.contains_cur(xi) {
+                        return None;
+                    }
+                    c.surface_any(xi)?
+                }
+            };
+            if hit.signed >= to {
+                return None;
+            }
+            Some((i, hit.point + hit.out * to, hit.out))
+        })
+        .collect()
+}
+
+/// Coulomb friction: reduces the tangential part of `vrel` (relative to the surface with unit
+/// normal `n`) by `limit` (m/s), stopping it when smaller; the normal part is kept.
+#[inline]
+fn friction(vrel: Vec3, n: Vec3, limit: f32) -> Vec3 {
+    let vn = vrel.dot(n);
+    let vt = vrel - vn * n;
+    let s = vt.length();
+    let limit = limit.max(0.0);
+    let scale = if s > limit { 1.0 - limit / s } else { 0.0 };
+    vn * n + vt * scale
+}
