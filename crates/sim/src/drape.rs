@@ -194,7 +194,7 @@ pub fn drape(
         &sim.strains(),
     );
     if stats.max_penetration_m > opts.max_penetration {
-        return Err(SimError::Diverged(format!(
+        return Err(SimError::Rejected(format!(
             "cloth left {:.2} mm inside the body (at most {:.2} mm allowed)",
             stats.max_penetration_m * 1e3,
             opts.max_penetration * 1e3

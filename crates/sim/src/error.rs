@@ -19,6 +19,9 @@ pub enum SimError {
     /// the step.
     #[error("simulation diverged: {0}")]
     Diverged(String),
+    /// A finished drape failed a check (cloth left inside the body); it is not a result.
+    #[error("drape rejected: {0}")]
+    Rejected(String),
     /// The sparse Cholesky factorisation of the system matrix failed (it should be positive
     /// definite by construction, so this means degenerate input such as zero mass).
     #[error("linear solver: {0}")]
