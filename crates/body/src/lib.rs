@@ -7,6 +7,7 @@
 //! Y up, the body facing +Z.
 
 pub mod assets;
+pub mod clearance;
 pub mod error;
 pub mod model;
 pub mod phenotype;

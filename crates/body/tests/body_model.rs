@@ -261,3 +261,60 @@ fn self_contact_flags_an_arm_through_the_torso_but_not_the_rest_pose() {
     let posed = body.posed(&pose, Skinning::Dqs).unwrap();
     assert!(contact.count_intersections(&posed) > 20);
 }
+
+/// A pose of `body` with the left arm (and everything below it) pointing along `dir`.
+fn left_arm_along(body: &body::ShapedBody, dir: Vec3) -> Pose {
+    let rig = &body.rig;
+    let arm = rig.index("LeftArm").unwrap();
+    let (head, tail) = (rig.bones[arm].head, rig.bones[arm].tail);
+    let swing = Quat::from_rotation_arc((tail - head).normalize(), dir.normalize());
+    let mut world = vec![Quat::IDENTITY; rig.len()];
+    let mut below = vec![false; rig.len()];
+    for (b, bone) in rig.bones.iter().enumerate() {
+        below[b] = b == arm || bone.parent.is_some_and(|p| below[p]);
+        if below[b] {
+            world[b] = swing;
+        }
+    }
+    Pose::from_world_rotations(rig, &world, Vec3::ZERO)
+}
+
+#[test]
+fn clearance_leaves_the_rest_pose_alone_and_lifts_an_arm_out_of_the_chest() {
+    use body::clearance::{clear_limbs, ClearanceOptions};
+    let body = model()
+        .shape(&Phenotype {
+            weight: 1.0,
+            ..Default::default()
+        })
+        .unwrap();
+    let opts = ClearanceOptions::default();
+    let rest = Pose::identity(body.rig.len());
+    let (same, report) = clear_limbs(&body, &rest, &opts).unwrap();
+    assert_eq!(same, rest);
+    assert_eq!(report.largest_turn_deg(), 0.0);
+
+    // A heavy body's left arm hanging straight down and a little inward sinks into the
+    // chest (the left arm is on +X).
+    let sunk = left_arm_along(&body, Vec3::new(-0.15, -1.0, 0.0));
+    let (cleared, report) = clear_limbs(&body, &sunk, &opts).unwrap();
+    assert!(
+        report.buried_before[0] > report.buried_rest[0] + opts.tolerance,
+        "the test pose must bury the upper arm: {report:?}"
+    );
+    assert!(
+        report.buried_after[0] <= report.buried_rest[0] + opts.tolerance,
+        "{report:?}"
+    );
+    assert!(report.turned[0] > 0.0, "{report:?}");
+    let hand = body.rig.index("LeftHand").unwrap();
+    let before = body.rig.posed_joints(&sunk)[hand].0;
+    let after = body.rig.posed_joints(&cleared)[hand].0;
+    assert!(
+        after.x > before.x + 0.02,
+        "hand moved out: {before} -> {after}"
+    );
+    // The right side was not touched.
+    let right = body.rig.index("RightArm").unwrap();
+    assert!(cleared.rotations[right].angle_between(sunk.rotations[right]) < 1e-5);
+}

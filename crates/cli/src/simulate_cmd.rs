@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use body::clearance::ClearanceOptions;
 use body::BodyModel;
 use clap::Args;
 use garment::GarmentTemplate;
@@ -53,6 +54,10 @@ pub struct SimulateArgs {
     /// A drape leaving a garment vertex deeper than this inside the body fails, mm.
     #[arg(long, default_value_t = 1.0)]
     pub max_penetration_mm: f32,
+    /// Drape the pose exactly as given: no limb clearance (by default a limb that sinks
+    /// into the body, as a heavy arm into the chest, is first turned out of it).
+    #[arg(long)]
+    pub keep_pose: bool,
     /// Instead: 30 drapes (T-shirt, sweater, jeans x 10 random shapes and poses) into a
     /// picture sheet, with their statistics beside it (.json, .md).
     #[arg(long, value_name = "FILE.png")]
@@ -71,6 +76,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         skinning: args.skinning.into(),
         max_settle_steps: args.max_settle_steps,
         max_penetration: args.max_penetration_mm * 1e-3,
+        clearance: (!args.keep_pose).then(ClearanceOptions::default),
         ..DrapeOptions::default()
     };
     if let Some(sheet) = &args.sheet {

@@ -169,13 +169,13 @@ fn short(what: &str) -> String {
 /// A Markdown table of the cases and a summary line.
 fn markdown(cases: &[Case]) -> String {
     let mut out = String::from(
-        "| garment | shape | pose | time (s) | steps | at rest | max pen. (mm) | strain p99 (%) |\n|---|---|---|---:|---:|---|---:|---:|\n",
+        "| garment | shape | pose | time (s) | steps | at rest | max pen. (mm) | strain p99 (%) | limbs turned (deg) |\n|---|---|---|---:|---:|---|---:|---:|---:|\n",
     );
     for c in cases {
         match &c.stats {
             Some(s) => {
                 out += &format!(
-                    "| {} | {} | {} | {:.2} | {} | {} | {:.2} | {:.2} |\n",
+                    "| {} | {} | {} | {:.2} | {} | {} | {:.2} | {:.2} | {:.0} |\n",
                     c.garment,
                     c.shape_seed,
                     c.pose,
@@ -183,12 +183,13 @@ fn markdown(cases: &[Case]) -> String {
                     s.animation_steps + s.settle_steps,
                     if s.converged { "yes" } else { "no" },
                     s.max_penetration_m * 1e3,
-                    s.strain_p99 * 100.0
+                    s.strain_p99 * 100.0,
+                    s.limb_turn_deg
                 )
             }
             None => {
                 out += &format!(
-                    "| {} | {} | {} | failed: {} | | | | |\n",
+                    "| {} | {} | {} | failed: {} | | | | | |\n",
                     c.garment,
                     c.shape_seed,
                     c.pose,

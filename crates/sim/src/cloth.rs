@@ -70,6 +70,8 @@ pub struct ClothSim {
     /// `[N]` whether the factored matrix holds the vertex's contact weight.
     pub(crate) factored: Vec<bool>,
     pub(crate) steps_since_refactor: u32,
+    /// Steps taken since the simulation was made.
+    pub(crate) steps_taken: u64,
     /// `[N]` normal contact force at the end of the last step, N (0: not pressed).
     pub(crate) last_force: Vec<f64>,
     /// `[N]` body velocity at the contact during the last step (zero when not in contact).
@@ -113,6 +115,7 @@ impl ClothSim {
             contact_w,
             factored: vec![false; n],
             steps_since_refactor: 0,
+            steps_taken: 0,
             last_force: vec![0.0; n],
             body_vel: vec![Vec3::ZERO; n],
         };

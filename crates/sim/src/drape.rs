@@ -10,6 +10,7 @@
 
 use std::time::Instant;
 
+use body::clearance::{clear_limbs, ClearanceOptions};
 use body::{Pose, ShapedBody, Skinning};
 use garment::warp::SurfaceAnchors;
 use garment::GarmentTemplate;
@@ -43,6 +44,10 @@ pub struct DrapeOptions {
     /// surface anchors, so a garment fits a larger body as it fits the template body.
     /// Without it a small template is stretched over a large body.
     pub grade: bool,
+    /// Correct the pose first so no limb sinks into the body (see [`body::clearance`]):
+    /// cloth cannot lie where a skinned arm overlaps the chest. `None` drapes the pose as
+    /// given.
+    pub clearance: Option<ClearanceOptions>,
 }
 
 impl Default for DrapeOptions {
@@ -57,6 +62,7 @@ impl Default for DrapeOptions {
             max_penetration: 0.001,
             skinning: Skinning::Dqs,
             grade: true,
+            clearance: Some(ClearanceOptions::default()),
         }
     }
 }
@@ -71,6 +77,8 @@ pub struct Drape {
     pub garment: TriMesh,
     /// The body in the target shape and pose.
     pub body: TriMesh,
+    /// The pose the body took: the target pose after the limb clearance correction.
+    pub pose: Pose,
     /// What the drape took and reached.
     pub stats: DrapeStats,
 }
@@ -114,7 +122,15 @@ pub fn drape(
             "the pose does not fit the body's rig or holds NaN".into(),
         ));
     }
-    let (yaw, mut calm) = remove_root_yaw(target, pose);
+    let (pose, limb_turn_deg) = match &opts.clearance {
+        Some(c) => {
+            let (p, report) =
+                clear_limbs(target, pose, c).map_err(|e| SimError::InvalidInput(e.to_string()))?;
+            (p, report.largest_turn_deg())
+        }
+        None => (pose.clone(), 0.0),
+    };
+    let (yaw, mut calm) = remove_root_yaw(target, &pose);
     calm.rotations.iter_mut().for_each(|q| *q = q.normalize());
     let mut sim = if opts.grade {
         let anchors = SurfaceAnchors::new(&template.mesh, &template_body.mesh)
@@ -187,6 +203,7 @@ pub fn drape(
         settle_steps: step - animation_steps,
         final_kinetic_energy: sim.kinetic_energy(),
         converged,
+        limb_turn_deg,
         ..Default::default()
     };
     stats.measure(
@@ -213,6 +230,7 @@ pub fn drape(
             vertices: body.iter().map(turn).collect(),
             faces: target.mesh.faces.clone(),
         },
+        pose,
         stats,
     })
 }

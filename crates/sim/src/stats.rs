@@ -28,6 +28,9 @@ pub struct DrapeStats {
     pub strain_max: f32,
     /// Whether the kinetic energy fell below the rest threshold before the step budget.
     pub converged: bool,
+    /// The largest turn of a limb joint by the clearance correction of the pose, degrees.
+    #[serde(default)]
+    pub limb_turn_deg: f32,
 }
 
 /// The value at quantile `q` in [0, 1] of `values` (nearest rank; 0 for none).
@@ -56,7 +59,7 @@ impl DrapeStats {
     /// One line for people: time, steps, energy, penetration in mm, strain in percent.
     pub fn summary(&self) -> String {
         format!(
-            "{:.2} s, {} + {} steps, KE {:.2e} J, {}, penetration max {:.2} mm p99 {:.2} mm, strain p50 {:.2}% p99 {:.2}% max {:.2}%",
+            "{:.2} s, {} + {} steps, KE {:.2e} J, {}, penetration max {:.2} mm p99 {:.2} mm, strain p50 {:.2}% p99 {:.2}% max {:.2}%, limbs turned {:.0} deg",
             self.wall_time_s,
             self.animation_steps,
             self.settle_steps,
@@ -66,7 +69,8 @@ impl DrapeStats {
             self.p99_penetration_m * 1e3,
             self.strain_p50 * 100.0,
             self.strain_p99 * 100.0,
-            self.strain_max * 100.0
+            self.strain_max * 100.0,
+            self.limb_turn_deg
         )
     }
 }

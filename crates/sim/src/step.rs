@@ -39,6 +39,10 @@ const REFACTOR_MISSING: usize = 200;
 const REFACTOR_AGE: u32 = 4;
 /// ...or when more than this fraction of the free vertices hold a stale contact weight.
 const REFACTOR_STALE: usize = 50;
+/// Every this many steps, every vertex away from the surface gets the exact inside test
+/// (a vertex pressed deeper than the contact reach, as in an armpit closing on it, is
+/// otherwise never seen again).
+const FULL_INSIDE_CHECK: u64 = 5;
 
 impl ClothSim {
     /// Advances the simulation by one time step `params().dt`, colliding with `collider` if
@@ -155,7 +159,8 @@ impl ClothSim {
 
         // 6. Collision projection.
         if let Some(c) = collider.as_deref() {
-            let fixes = project_out(self, c, &x1, &dist0, reach, thick * PROJECT_FRACTION);
+            let full = self.steps_taken % FULL_INSIDE_CHECK == 0;
+            let fixes = project_out(self, c, &x1, &dist0, reach, thick * PROJECT_FRACTION, full);
             info.projected = fixes.len();
             for (i, target, nrm) in fixes {
                 let push = (target - x1[i]).length();
@@ -196,6 +201,7 @@ impl ClothSim {
         self.x = x1;
         self.v = v1;
         self.last_force = force;
+        self.steps_taken += 1;
         if let Some(c) = collider {
             c.commit();
         }
@@ -259,6 +265,7 @@ fn project_out(
     dist0: &[f32],
     reach: f32,
     to: f32,
+    full: bool,
 ) -> Vec<(usize, Vec3, Vec3)> {
     let max_disp = c.max_displacement();
     let (x0, pinned) = (&sim.x, &sim.pinned);
@@ -274,7 +281,7 @@ fn project_out(
                 Some(hit) => hit,
                 None => {
                     let travel = (xi - x0[i]).length() + max_disp;
-                    if travel < dist0[i] || !c.contains_cur(xi) {
+                    if (!full && travel < dist0[i]) || !c.contains_cur(xi) {
                         return None;
                     }
                     c.surface_any(xi)?

@@ -79,3 +79,68 @@ fn a_turned_body_gets_the_same_drape_turned() {
         "jeans around the legs, mean at {mean}"
     );
 }
+
+/// Regression: a heavy body with its arms hanging slightly inward sinks the upper arms
+/// into the chest (skinning); the sleeves caught in that overlap ended 10-30 mm inside the
+/// body. The drape now corrects the pose first (limb clearance) and the shirt stays out.
+#[test]
+fn arms_sunk_into_a_heavy_chest_are_cleared_before_draping() {
+    let model = BodyModel::load().expect("body assets");
+    let kind = GarmentKind::Tshirt;
+    let template = build_template(&model, &kind, &CutParams::default_for(&kind), 0.03).unwrap();
+    let template_body = model.shape(&template.body_phenotype).unwrap();
+    let target = model
+        .shape(&Phenotype {
+            weight: 1.0,
+            ..Default::default()
+        })
+        .unwrap();
+    // Both upper arms (and everything below them) hang down and 8 degrees inward.
+    let rig = &target.rig;
+    let mut world = vec![Quat::IDENTITY; rig.len()];
+    for (name, side) in [("LeftArm", -1.0f32), ("RightArm", 1.0)] {
+        let arm = rig.index(name).unwrap();
+        let dir = (rig.bones[arm].tail - rig.bones[arm].head).normalize();
+        let swing = Quat::from_rotation_arc(dir, Vec3::new(side * 0.14, -1.0, 0.0).normalize());
+        let mut below = vec![false; rig.len()];
+        for (b, bone) in rig.bones.iter().enumerate() {
+            below[b] = b == arm || bone.parent.is_some_and(|p| below[p]);
+            if below[b] {
+                world[b] = swing;
+            }
+        }
+    }
+    let pose = Pose::from_world_rotations(rig, &world, Vec3::ZERO);
+    let opts = DrapeOptions {
+        max_settle_steps: 150,
+        ..DrapeOptions::default()
+    };
+    let cleared = drape(
+        &template,
+        &template_body,
+        &target,
+        &pose,
+        &opts,
+        &mut |_, _, _| {},
+    )
+    .expect("the cleared pose drapes without penetration");
+    assert!(cleared.stats.limb_turn_deg > 0.0, "{:?}", cleared.stats);
+    assert_ne!(cleared.pose, pose);
+    let as_given = DrapeOptions {
+        clearance: None,
+        ..opts
+    };
+    let raw = drape(
+        &template,
+        &template_body,
+        &target,
+        &pose,
+        &as_given,
+        &mut |_, _, _| {},
+    );
+    assert!(
+        matches!(raw, Err(sim::SimError::Rejected(_))),
+        "without the correction the sleeves end inside: {:?}",
+        raw.map(|d| d.stats)
+    );
+}

@@ -1,0 +1,246 @@
+//! Limb clearance: a skinned body sinks its limbs into itself where a real one would push
+//! them apart (a heavy arm hanging at the side sinks into the chest; a raised thigh sinks
+//! into the belly). Cloth cannot lie in such an overlap, so a pose meant for draping is
+//! corrected first: each limb whose surface is buried in the body turns about its root
+//! joint (shoulder or hip), a few degrees at a time, away from what it is buried in, until
+//! its buried surface is down to what the rest pose has (the skin folds of armpit and
+//! groin).
+//!
+//! A body vertex is *buried* when the point [`PROBE`] outside it along its normal lies
+//! inside the body (ray-voting winding test).
+
+use geom::bvh::Bvh;
+use geom::TriMesh;
+use glam::{Quat, Vec3};
+use rayon::prelude::*;
+
+use crate::model::ShapedBody;
+use crate::rig::Pose;
+use crate::self_contact::vertex_segments;
+use crate::skin::Skinning;
+use crate::BodyError;
+
+/// A vertex is buried when the point this far outside it (metres) is inside the body.
+pub const PROBE: f32 = 0.002;
+
+/// The bone that turns each limb segment (indexed as [`crate::self_contact::SEGMENTS`];
+/// the torso, segment 0, does not turn).
+const SEGMENT_BONES: [&str; 8] = [
+    "LeftArm",
+    "LeftForeArm",
+    "RightArm",
+    "RightForeArm",
+    "LeftUpLeg",
+    "LeftLeg",
+    "RightUpLeg",
+    "RightLeg",
+];
+/// Rounds a segment may go on turning without reducing its buried count.
+const PATIENCE: u32 = 2;
+
+/// Settings of [`clear_limbs`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClearanceOptions {
+    /// Turn per round, radians.
+    pub step: f32,
+    /// Most rounds per limb (the largest correction is `step * max_rounds`).
+    pub max_rounds: u32,
+    /// A limb segment is clear when it has at most this many more buried vertices than in
+    /// the rest pose.
+    pub tolerance: usize,
+}
+
+impl Default for ClearanceOptions {
+    /// 3 degree turns, at most 12 (36 degrees), 10 vertices of tolerance.
+    fn default() -> Self {
+        Self {
+            step: 3f32.to_radians(),
+            max_rounds: 12,
+            tolerance: 10,
+        }
+    }
+}
+
+/// What [`clear_limbs`] did, per limb segment (upper and lower arm, left then right, then
+/// the legs likewise: [`SEGMENT_BONES`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ClearanceReport {
+    /// Buried vertices of each segment in the rest pose (skin folds, allowed).
+    pub buried_rest: [usize; 8],
+    /// ...in the given pose...
+    pub buried_before: [usize; 8],
+    /// ...and after the correction.
+    pub buried_after: [usize; 8],
+    /// Angle each segment's bone turned, radians.
+    pub turned: [f32; 8],
+}
+
+impl ClearanceReport {
+    /// The largest turn of a segment, degrees.
+    pub fn largest_turn_deg(&self) -> f32 {
+        self.turned
+            .iter()
+            .fold(0.0f32, |a, &b| a.max(b))
+            .to_degrees()
+    }
+}
+
+/// `[N]` whether each vertex of `posed` is buried inside the body (see the module docs).
+pub fn buried_vertices(posed: &TriMesh) -> Result<Vec<bool>, BodyError> {
+    buried_where(posed, |_| true)
+}
+
+/// [`buried_vertices`] for the vertices `test(v)` accepts; `false` for the others.
+fn buried_where(
+    posed: &TriMesh,
+    test: impl Fn(usize) -> bool + Sync,
+) -> Result<Vec<bool>, BodyError> {
+    let bvh = Bvh::from_mesh(posed).map_err(|e| BodyError::Parameter(e.to_string()))?;
+    let normals = geom::normals::vertex_normals(&posed.vertices, &posed.faces);
+    Ok(posed
+        .vertices
+        .par_iter()
+        .zip(&normals)
+        .enumerate()
+        .with_min_len(256)
+        .map(|(i, (&v, &n))| test(i) && bvh.contains(v + n * PROBE))
+        .collect())
+}
+
+/// Buried vertex count of each limb segment, and the mean position and mean normal of its
+/// buried vertices (zero when none).
+fn segment_burial(posed: &TriMesh, segments: &[u8]) -> Result<[(usize, Vec3, Vec3); 8], BodyError> {
+    // The torso (segment 0) does not turn: only the limbs are tested.
+    let buried = buried_where(posed, |v| segments[v] > 0)?;
+    let normals = geom::normals::vertex_normals(&posed.vertices, &posed.faces);
+    let mut out = [(0usize, Vec3::ZERO, Vec3::ZERO); 8];
+    for (v, _) in buried.iter().enumerate().filter(|(_, &b)| b) {
+        if let Some(o) = (segments[v] as usize)
+            .checked_sub(1)
+            .and_then(|s| out.get_mut(s))
+        {
+            o.0 += 1;
+            o.1 += posed.vertices[v];
+            o.2 += normals[v];
+        }
+    }
+    for o in &mut out {
+        if o.0 > 0 {
+            o.1 /= o.0 as f32;
+            o.2 = o.2.normalize_or_zero();
+        }
+    }
+    Ok(out)
+}
+
+/// Corrects `pose` so no limb segment of `body` (posed with DQS) sinks into the body more
+/// than in its rest pose (see the module docs). The bone of each buried segment (shoulder,
+/// elbow, hip or knee) turns so that the segment's buried part moves against its own
+/// outward normal there (out of what it is buried in), while that helps; a segment whose
+/// count stops falling keeps its best angle. Returns the corrected pose and what changed;
+/// a pose with clear limbs comes back unchanged.
+pub fn clear_limbs(
+    body: &ShapedBody,
+    pose: &Pose,
+    opts: &ClearanceOptions,
+) -> Result<(Pose, ClearanceReport), BodyError> {
+    let segments = vertex_segments(body);
+    let bones: Vec<usize> = SEGMENT_BONES
+        .iter()
+        .map(|name| {
+            body.rig
+                .index(name)
+                .ok_or_else(|| BodyError::UnknownBone((*name).into()))
+        })
+        .collect::<Result<_, _>>()?;
+    let rest = segment_burial(&body.mesh, &segments)?;
+    let mut burial = segment_burial(&body.posed(pose, Skinning::Dqs)?, &segments)?;
+    let mut report = ClearanceReport {
+        buried_rest: rest.map(|b| b.0),
+        buried_before: burial.map(|b| b.0),
+        ..Default::default()
+    };
+    let too_buried = |b: &[(usize, Vec3, Vec3); 8], s: usize| b[s].0 > rest[s].0 + opts.tolerance;
+    // Each turning segment's best count, its world rotations then, and rounds since.
+    let mut world = body.rig.world_rotations(pose);
+    let mut best: Vec<Option<(usize, Vec<Quat>, u32)>> = (0..8)
+        .map(|s| too_buried(&burial, s).then(|| (burial[s].0, world.clone(), 0)))
+        .collect();
+    let mut turned = [0f32; 8];
+    let mut best_turn = [0f32; 8];
+    for _ in 0..opts.max_rounds {
+        let joints = body.rig.posed_joints(&Pose::from_world_rotations(
+            &body.rig,
+            &world,
+            pose.root_translation,
+        ));
+        let mut any = false;
+        for s in 0..8 {
+            if best[s].is_none() || burial[s].2 == Vec3::ZERO {
+                continue;
+            }
+            let b = bones[s];
+            let lever = burial[s].1 - joints[b].0;
+            // Move the buried part along minus its outward normal: turn about lever x (-n).
+            let Some(axis) = lever.cross(-burial[s].2).try_normalize() else {
+                continue;
+            };
+            let turn = Quat::from_axis_angle(axis, opts.step);
+            // The bones below keep their rotation relative to this one.
+            for c in std::iter::once(b).chain(descendants(body, b)) {
+                world[c] = (turn * world[c]).normalize();
+            }
+            turned[s] += opts.step;
+            any = true;
+        }
+        if !any {
+            break;
+        }
+        let candidate = Pose::from_world_rotations(&body.rig, &world, pose.root_translation);
+        burial = segment_burial(&body.posed(&candidate, Skinning::Dqs)?, &segments)?;
+        for s in 0..8 {
+            let Some((count, rotations, stale)) = &mut best[s] else {
+                continue;
+            };
+            if burial[s].0 < *count {
+                *count = burial[s].0;
+                *rotations = world.clone();
+                *stale = 0;
+                best_turn[s] = turned[s];
+            } else {
+                *stale += 1;
+            }
+            if !too_buried(&burial, s) || *stale > PATIENCE {
+                // Done: this segment's chain goes back to its best angle.
+                for c in std::iter::once(bones[s]).chain(descendants(body, bones[s])) {
+                    world[c] = rotations[c];
+                }
+                best[s] = None;
+            }
+        }
+    }
+    // Segments still turning at the end keep their best angle too.
+    for s in 0..8 {
+        if let Some((_, rotations, _)) = &best[s] {
+            for c in std::iter::once(bones[s]).chain(descendants(body, bones[s])) {
+                world[c] = rotations[c];
+            }
+        }
+    }
+    let pose = Pose::from_world_rotations(&body.rig, &world, pose.root_translation);
+    report.buried_after =
+        segment_burial(&body.posed(&pose, Skinning::Dqs)?, &segments)?.map(|b| b.0);
+    report.turned = best_turn;
+    Ok((pose, report))
+}
+
+/// Every bone below `bone` in the rig (not `bone` itself).
+fn descendants(body: &ShapedBody, bone: usize) -> Vec<usize> {
+    let mut out = Vec::new();
+    let mut stack: Vec<usize> = body.rig.children(bone).collect();
+    while let Some(c) = stack.pop() {
+        out.push(c);
+        stack.extend(body.rig.children(c));
+    }
+    out
+}
