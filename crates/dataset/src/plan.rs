@@ -177,7 +177,7 @@ impl Plan {
                         file,
                         format!("garments[{g}].poses_per_body"),
                         format!(
-                            "{} distinct poses per body, but split '{name}' can use only {n} poses; add pose sources or lower it",
+                            "{} distinct poses per body, but split '{name}' can use only {n} of them; add pose sources or lower it",
                             garment.poses_per_body
                         ),
                     ));

@@ -114,6 +114,11 @@ impl SampleArrays {
         let need = |name: &str, cols: usize| -> Result<Vec<f32>> {
             Ok(floats(name, cols, true)?.expect("required"))
         };
+        let (body, warped, draped) = (
+            points(need("body", 3)?),
+            points(need("warped", 3)?),
+            points(need("draped", 3)?),
+        );
         let root = need("pose.root", 1)?;
         if root.len() != 3 {
             return Err(DatasetError::corrupt(
@@ -122,9 +127,9 @@ impl SampleArrays {
             ));
         }
         let out = Self {
-            body: points(need("body", 3)?),
-            warped: points(need("warped", 3)?),
-            draped: points(need("draped", 3)?),
+            body,
+            warped,
+            draped,
             fitted: floats("fitted", 3, false)?.map(points),
             phenotype: need("phenotype", 1)?,
             root_translation: Vec3::from_slice(&root),
