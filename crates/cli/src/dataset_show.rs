@@ -57,9 +57,9 @@ pub fn show(args: &ShowArgs) -> anyhow::Result<()> {
     let faces = &template.mesh.faces;
     let color = garment_color(&kind);
     let panels: [(Vec<RenderMesh>, &str); 3] = [
-        (vec![body.clone()], "body"),
+        (vec![body], "body"),
         (
-            vec![body.clone(), RenderMesh::new(&a.warped, faces, color)],
+            vec![body, RenderMesh::new(&a.warped, faces, color)],
             "M: warped (DQS)",
         ),
         (

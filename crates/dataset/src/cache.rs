@@ -5,10 +5,13 @@ use std::collections::{HashMap, VecDeque};
 use std::hash::Hash;
 use std::sync::{Arc, Mutex, OnceLock};
 
+/// The cells by key, and the keys from oldest to newest.
+type Cells<K, V> = (HashMap<K, Arc<OnceLock<V>>>, VecDeque<K>);
+
 /// Values of type `V` by key, computed on first use; at most `capacity` kept.
 pub struct KeyedCache<K, V> {
     capacity: usize,
-    inner: Mutex<(HashMap<K, Arc<OnceLock<V>>>, VecDeque<K>)>,
+    inner: Mutex<Cells<K, V>>,
 }
 
 impl<K: Hash + Eq + Clone, V: Clone> KeyedCache<K, V> {
