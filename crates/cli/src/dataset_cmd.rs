@@ -181,7 +181,7 @@ fn generate(args: &GenerateArgs) -> anyhow::Result<()> {
     let bar = ProgressBar::new(0);
     bar.set_style(
         ProgressStyle::with_template(
-            "{elapsed_precise} [{bar:30}] {pos}/{len} samples, {per_sec}, ETA {eta} {msg}",
+            "{elapsed_precise} [{bar:25}] {pos}/{len} {per_sec} ETA {eta} {msg}",
         )
         .expect("valid template")
         .progress_chars("=> "),
@@ -189,12 +189,14 @@ fn generate(args: &GenerateArgs) -> anyhow::Result<()> {
     let started = std::sync::atomic::AtomicBool::new(false);
     let progress = |p: &dataset::Progress| {
         if !started.swap(true, std::sync::atomic::Ordering::SeqCst) {
+            // The rate and ETA count from the first sample of this run.
             bar.set_length(p.total);
-            bar.set_position(p.done - 1);
+            bar.set_position(p.done);
             bar.reset_eta();
+        } else {
+            bar.set_position(p.done);
         }
-        bar.set_position(p.done);
-        bar.set_message(format!("({} failed)", p.failed));
+        bar.set_message(format!("{} failed", p.failed));
     };
     opts.progress = Some(&progress);
     eprintln!(

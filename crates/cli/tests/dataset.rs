@@ -106,6 +106,28 @@ fn plan_describes_specs_and_names_bad_fields() {
         out.contains("56400 samples") && out.contains("split train: 500 bodies"),
         "{out}"
     );
+    // A BVH clip (converted from a CMU clip) as a pose source.
+    let root = dir.path().join("mocap");
+    std::fs::create_dir_all(&root).unwrap();
+    let cmu = mocap.join("cmu/02");
+    ok(&[
+        "pose",
+        "convert",
+        "--asf",
+        s(&cmu.join("02.asf")),
+        "--amc",
+        s(&cmu.join("02_01.amc")),
+        "--out",
+        s(&root.join("walk.bvh")),
+    ]);
+    let bvh = dir.path().join("bvh.toml");
+    let text = FAST.replace(
+        "[[poses.procedural]]",
+        "[[poses.bvh]]\nclips = [\"walk.bvh\"]\nevery = 50\n[[poses.procedural]]",
+    );
+    std::fs::write(&bvh, text).unwrap();
+    let out = ok(&["dataset", "plan", s(&bvh), "--mocap", s(&root)]);
+    assert!(out.contains("pose pool: 11 poses in 2 motions"), "{out}");
     let err = fails(&[
         "dataset",
         "plan",

@@ -56,6 +56,18 @@ fn two_job_array_runs_merge_into_the_same_dataset() {
         .unwrap_err()
         .to_string()
         .contains("already holds"));
+    // A template that differs between the inputs is refused.
+    let file = runs[1].join("templates/tshirt.garment");
+    let mut t = garment::GarmentTemplate::load(&file).unwrap();
+    t.mesh.vertices[0].x += 0.01;
+    t.save(&file).unwrap();
+    let mut m = Manifest::load(&runs[1]).unwrap();
+    m.templates.get_mut("tshirt").unwrap().sha256 = dataset::hash::sha256_file(&file).unwrap();
+    m.save(&runs[1]).unwrap();
+    let e = merge(&root.path().join("bad"), &runs)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("template tshirt differs"), "{e}");
 }
 
 #[test]

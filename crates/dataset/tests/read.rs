@@ -50,7 +50,23 @@ fn samples_have_the_documented_shapes() {
         let top = a.body.iter().map(|p| p.y).fold(f32::MIN, f32::max);
         assert!((1.2..2.2).contains(&top), "{top}");
         assert_eq!(s.record.index, k);
+        let per_body = format!("jeans-b{:05}", s.record.body);
+        let id = if s.record.garment == "jeans" {
+            per_body.as_str()
+        } else {
+            "tshirt"
+        };
+        assert_eq!(s.record.template, id);
     }
+    // Each body's jeans have their own cut, so their own template.
+    let jeans: Vec<_> = (0..3)
+        .map(|b| data.template(&format!("jeans-b{b:05}")))
+        .collect();
+    let jeans: Vec<_> = jeans.into_iter().map(|t| t.unwrap().cut.unwrap()).collect();
+    assert!(
+        jeans[0].leg_length != jeans[1].leg_length && jeans[1].leg_length != jeans[2].leg_length
+    );
+    assert!(jeans.iter().all(|c| (0.5..=0.8).contains(&c.leg_length)));
     assert!(data
         .sample(999)
         .unwrap_err()

@@ -10,8 +10,8 @@ use std::sync::OnceLock;
 use body::BodyModel;
 use dataset::{GenerateOptions, GenerateReport, LoadedSpec};
 
-/// 3 bodies (2 train, 1 test) x (T-shirt in 2 poses + jeans in 1), 8 cm edges, 10
-/// simulator steps: 9 samples in 5 shards of 2.
+/// 3 bodies (2 train, 1 test) x (T-shirt in 2 poses + jeans in 1, cut per body), 8 cm
+/// edges, 10 simulator steps: 9 samples in 5 shards of 2.
 pub const FAST: &str = r#"
 name = "fast"
 seed = 3
@@ -26,6 +26,7 @@ poses_per_body = 2
 kind = "jeans"
 edge = 0.08
 poses_per_body = 1
+cut_ranges = { leg_length = [0.5, 0.8] }
 [[poses.procedural]]
 kind = "any"
 count = 6
