@@ -32,6 +32,7 @@ pub mod poses;
 pub mod reader;
 pub mod records;
 pub mod rng;
+mod run;
 pub mod sample;
 pub mod selection;
 pub mod shard;
