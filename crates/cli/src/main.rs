@@ -3,6 +3,8 @@
 mod assets_cmd;
 mod bench_cmd;
 mod body_cmd;
+mod dataset_cmd;
+mod dataset_show;
 mod garment_cmd;
 mod garment_sheet;
 mod output;
@@ -40,6 +42,9 @@ enum Cmd {
     Pose(pose_cmd::PoseCmd),
     /// Drape a garment template on a body with the cloth simulator.
     Simulate(simulate_cmd::SimulateArgs),
+    /// Datasets: check a spec, generate (sharded, resumable), merge, inspect, show.
+    #[command(subcommand)]
+    Dataset(dataset_cmd::DatasetCmd),
     /// Benchmarks measured in one run, reported with ratios to a reference.
     #[command(subcommand)]
     Bench(bench_cmd::BenchCmd),
@@ -54,6 +59,7 @@ fn main() {
         Some(Cmd::Garment(c)) => garment_cmd::run(c),
         Some(Cmd::Pose(c)) => pose_cmd::run(c),
         Some(Cmd::Simulate(a)) => simulate_cmd::run(a),
+        Some(Cmd::Dataset(c)) => dataset_cmd::run(c),
         Some(Cmd::Bench(c)) => bench_cmd::run(c),
     };
     if let Err(e) = result {

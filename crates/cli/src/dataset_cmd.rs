@@ -1,0 +1,279 @@
+//! `garnet dataset`: check a spec, generate (sharded, resumable), merge, inspect, show.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use body::BodyModel;
+use clap::{Args, Subcommand};
+use dataset::{Dataset, GenerateOptions, LoadedSpec, Plan, ShardSelection, Summary};
+use indicatif::{ProgressBar, ProgressStyle};
+
+/// `garnet dataset` subcommands.
+#[derive(Subcommand, Debug)]
+pub enum DatasetCmd {
+    /// Check a spec and show what it would make (no drapes).
+    Plan(PlanArgs),
+    /// Generate (or resume) a dataset: `garnet dataset generate SPEC --out DIR`.
+    Generate(GenerateArgs),
+    /// Merge the folders of `--shard i/n` runs into one dataset.
+    Merge(MergeArgs),
+    /// Counts per split and garment, simulator statistics, failures.
+    Info(InfoArgs),
+    /// A picture of one sample: the body, M (warped) and G (draped) side by side.
+    Show(crate::dataset_show::ShowArgs),
+}
+
+/// Where the mocap clips are.
+#[derive(Args, Debug)]
+pub struct MocapArg {
+    /// Folder that the spec's clip paths are relative to (default: $GARNET_MOCAP, else
+    /// ../shared/mocap relative to the working directory).
+    #[arg(long, value_name = "DIR")]
+    pub mocap: Option<PathBuf>,
+}
+
+impl MocapArg {
+    /// `--mocap`, else `GARNET_MOCAP`, else `../shared/mocap`.
+    pub fn root(&self) -> PathBuf {
+        self.mocap
+            .clone()
+            .or_else(|| std::env::var_os("GARNET_MOCAP").map(PathBuf::from))
+            .unwrap_or_else(|| PathBuf::from("../shared/mocap"))
+    }
+}
+
+/// Arguments of `garnet dataset plan`.
+#[derive(Args, Debug)]
+pub struct PlanArgs {
+    /// The spec file (TOML).
+    pub spec: PathBuf,
+    #[command(flatten)]
+    pub mocap: MocapArg,
+}
+
+/// Arguments of `garnet dataset generate`.
+#[derive(Args, Debug)]
+pub struct GenerateArgs {
+    /// The spec file (TOML).
+    pub spec: PathBuf,
+    /// The dataset folder (created; an existing one of the same spec is resumed).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Samples drawn in parallel (default: one per core).
+    #[arg(long)]
+    pub jobs: Option<usize>,
+    /// Make only shards s with s % n == i (for job arrays; merge the folders after).
+    #[arg(long, value_name = "i/n")]
+    pub shard: Option<String>,
+    /// Stop after making this many samples (resume later by running again).
+    #[arg(long, value_name = "N")]
+    pub max_samples: Option<u64>,
+    #[command(flatten)]
+    pub mocap: MocapArg,
+}
+
+/// Arguments of `garnet dataset merge`.
+#[derive(Args, Debug)]
+pub struct MergeArgs {
+    /// The merged dataset folder (new).
+    pub out: PathBuf,
+    /// The folders to merge.
+    #[arg(required = true)]
+    pub inputs: Vec<PathBuf>,
+}
+
+/// Arguments of `garnet dataset info`.
+#[derive(Args, Debug)]
+pub struct InfoArgs {
+    /// The dataset folder.
+    pub dir: PathBuf,
+    /// Also read every file and check its sha256.
+    #[arg(long)]
+    pub verify: bool,
+    /// Print the summary as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(cmd: &DatasetCmd) -> anyhow::Result<()> {
+    match cmd {
+        DatasetCmd::Plan(a) => plan(a),
+        DatasetCmd::Generate(a) => generate(a),
+        DatasetCmd::Merge(a) => merge(a),
+        DatasetCmd::Info(a) => info(a),
+        DatasetCmd::Show(a) => crate::dataset_show::show(a),
+    }
+}
+
+/// Loads the spec and its plan (reading the clips).
+fn load_plan(spec: &Path, mocap: &Path) -> anyhow::Result<(LoadedSpec, Plan)> {
+    let spec = LoadedSpec::load(spec)?;
+    let library = dataset::poses::PoseLibrary::load(&spec.spec, mocap)?;
+    let plan = Plan::new(&spec, &library.frame_counts())?;
+    Ok((spec, plan))
+}
+
+fn plan(args: &PlanArgs) -> anyhow::Result<()> {
+    let (spec, plan) = load_plan(&args.spec, &args.mocap.root())?;
+    println!(
+        "spec {} ({}), hash {}",
+        spec.path.display(),
+        spec.spec.name,
+        &spec.hash[..16]
+    );
+    println!(
+        "{} samples in {} shards of {}; {} bodies",
+        plan.total(),
+        plan.shard_count(),
+        plan.shard_size,
+        plan.bodies
+    );
+    for (g, garment) in plan.garments.iter().enumerate() {
+        println!(
+            "  garment {}: {} ({} cm edges, {} poses per body, {} cut): samples {}..{}",
+            garment.name,
+            garment.kind.name(),
+            garment.edge * 100.0,
+            garment.poses_per_body,
+            if garment.per_body() {
+                "per-body"
+            } else {
+                "fixed"
+            },
+            plan.offsets[g],
+            plan.offsets[g + 1]
+        );
+    }
+    for (i, name) in plan.split_names.iter().enumerate() {
+        println!(
+            "  split {name}: {} bodies{}",
+            plan.split_bodies(i).len(),
+            if plan.held_out[i] {
+                ", held-out poses only"
+            } else {
+                ""
+            }
+        );
+    }
+    let pool = &plan.pool;
+    let seen = pool.seen.iter().filter(|&&s| s).count();
+    println!(
+        "  pose pool: {} poses in {} motions ({} open to ordinary splits)",
+        pool.poses.len(),
+        pool.motions.len(),
+        seen
+    );
+    Ok(())
+}
+
+fn generate(args: &GenerateArgs) -> anyhow::Result<()> {
+    let spec = LoadedSpec::load(&args.spec)?;
+    let model = BodyModel::load()?;
+    let mut opts = GenerateOptions::new(args.mocap.root());
+    if let Some(j) = args.jobs {
+        anyhow::ensure!(j >= 1, "--jobs must be at least 1");
+        opts.jobs = j;
+    }
+    if let Some(s) = &args.shard {
+        opts.selection = ShardSelection::parse(s)?;
+    }
+    opts.max_new_samples = args.max_samples;
+    let bar = ProgressBar::new(0);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:25}] {pos}/{len} {per_sec} ETA {eta} {msg}",
+        )
+        .expect("valid template")
+        .progress_chars("=> "),
+    );
+    let started = std::sync::atomic::AtomicBool::new(false);
+    let progress = |p: &dataset::Progress| {
+        if !started.swap(true, std::sync::atomic::Ordering::SeqCst) {
+            // The rate and ETA count from the first sample of this run.
+            bar.set_length(p.total);
+            bar.set_position(p.done);
+            bar.reset_eta();
+        } else {
+            bar.set_position(p.done);
+        }
+        bar.set_message(format!("{} failed", p.failed));
+    };
+    opts.progress = Some(&progress);
+    eprintln!(
+        "generating {} into {} (shards {}, {} jobs)",
+        args.spec.display(),
+        args.out.display(),
+        opts.selection,
+        opts.jobs
+    );
+    let report = dataset::generate(&model, &spec, &args.out, &opts)
+        .with_context(|| format!("generating {}", args.out.display()))?;
+    bar.finish_and_clear();
+    eprintln!(
+        "{} of {} selected samples were already made; made {} now ({} failed) in {:.1} s; {} shards written{}",
+        report.resumed,
+        report.selected_samples,
+        report.made,
+        report.failed,
+        report.wall_s,
+        report.shards_written,
+        if report.stray_temps_removed > 0 {
+            format!("; removed {} stray temporary files", report.stray_temps_removed)
+        } else {
+            String::new()
+        }
+    );
+    let state = match (report.complete, report.finished) {
+        (true, _) => "the dataset is complete",
+        (false, true) => "the selected shards are finished; merge the job folders",
+        (false, false) => "stopped before the end: run the same command again to resume",
+    };
+    println!("{}: {state}", args.out.display());
+    Ok(())
+}
+
+fn merge(args: &MergeArgs) -> anyhow::Result<()> {
+    let r = dataset::merge(&args.out, &args.inputs)?;
+    println!(
+        "{}: {} of {} shards, {} samples, {} failures{}",
+        args.out.display(),
+        r.shards,
+        r.shard_count,
+        r.samples,
+        r.failures,
+        if r.complete {
+            ", complete".to_string()
+        } else {
+            format!(", missing shards {:?}", r.missing)
+        }
+    );
+    Ok(())
+}
+
+fn info(args: &InfoArgs) -> anyhow::Result<()> {
+    let data = Dataset::open(&args.dir)?;
+    let summary = Summary::of(data.manifest());
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&summary)?);
+    } else {
+        print!("{}", summary.report());
+    }
+    if args.verify {
+        let problems = data.verify();
+        for p in &problems {
+            eprintln!("garnet: {p}");
+        }
+        anyhow::ensure!(
+            problems.is_empty(),
+            "{} damaged files in {}",
+            problems.len(),
+            args.dir.display()
+        );
+        println!(
+            "verified: {} shards, {} templates and the body faces match their checksums",
+            data.manifest().shards.len(),
+            data.manifest().templates.len()
+        );
+    }
+    Ok(())
+}

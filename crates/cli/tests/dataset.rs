@@ -1,0 +1,274 @@
+//! Integration tests of `garnet dataset`: plan, generate (sharded, interrupted, resumed),
+//! merge, info (with checksum verification) and show, on a fast spec.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn garnet(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_garnet"))
+        .args(args)
+        .output()
+        .expect("garnet runs")
+}
+
+fn ok(args: &[&str]) -> String {
+    let out = garnet(args);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "garnet {args:?} failed:\n{stderr}");
+    String::from_utf8_lossy(&out.stdout).into_owned() + &stderr
+}
+
+fn fails(args: &[&str]) -> String {
+    let out = garnet(args);
+    assert!(!out.status.success(), "garnet {args:?} should fail");
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    stderr
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn mocap() -> Option<PathBuf> {
+    let dir = repo().join("../shared/mocap");
+    dir.is_dir().then_some(dir)
+}
+
+/// 2 bodies x (T-shirt in 2 poses + jeans in 1): 6 samples of 8 cm garments in 3
+/// shards, a few simulator steps each.
+const FAST: &str = r#"
+name = "cli"
+seed = 9
+shard_size = 2
+[bodies]
+count = 2
+[[garments]]
+kind = "tshirt"
+edge = 0.08
+poses_per_body = 2
+[[garments]]
+kind = "jeans"
+edge = 0.08
+poses_per_body = 1
+[[poses.procedural]]
+kind = "walk"
+count = 4
+[splits.bodies]
+train = 1
+test = 1
+[simulator]
+morph_steps = 2
+pose_steps = 3
+max_settle_steps = 5
+iterations = 2
+max_penetration = 0.5
+"#;
+
+#[test]
+fn plan_describes_specs_and_names_bad_fields() {
+    let dir = tempfile::tempdir().unwrap();
+    let spec = dir.path().join("fast.toml");
+    std::fs::write(&spec, FAST).unwrap();
+    let out = ok(&["dataset", "plan", s(&spec)]);
+    assert!(
+        out.contains("6 samples in 3 shards of 2; 2 bodies"),
+        "{out}"
+    );
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, FAST.replace("edge = 0.08", "edge = 0.9")).unwrap();
+    let err = fails(&["dataset", "plan", s(&bad)]);
+    assert!(
+        err.contains("bad.toml") && err.contains("garments[0].edge"),
+        "{err}"
+    );
+    let Some(mocap) = mocap() else {
+        eprintln!("skipped the repository specs: ../shared/mocap not present");
+        return;
+    };
+    for name in ["tiny", "standard", "paper"] {
+        let spec = repo().join(format!("specs/{name}.toml"));
+        let out = ok(&["dataset", "plan", s(&spec), "--mocap", s(&mocap)]);
+        assert!(out.contains("samples in"), "{out}");
+    }
+    let out = ok(&[
+        "dataset",
+        "plan",
+        s(&repo().join("specs/paper.toml")),
+        "--mocap",
+        s(&mocap),
+    ]);
+    assert!(
+        out.contains("56400 samples") && out.contains("split train: 500 bodies"),
+        "{out}"
+    );
+    // A BVH clip (converted from a CMU clip) as a pose source.
+    let root = dir.path().join("mocap");
+    std::fs::create_dir_all(&root).unwrap();
+    let cmu = mocap.join("cmu/02");
+    ok(&[
+        "pose",
+        "convert",
+        "--asf",
+        s(&cmu.join("02.asf")),
+        "--amc",
+        s(&cmu.join("02_01.amc")),
+        "--out",
+        s(&root.join("walk.bvh")),
+    ]);
+    let bvh = dir.path().join("bvh.toml");
+    let text = FAST.replace(
+        "[[poses.procedural]]",
+        "[[poses.bvh]]\nclips = [\"walk.bvh\"]\nevery = 50\n[[poses.procedural]]",
+    );
+    std::fs::write(&bvh, text).unwrap();
+    let out = ok(&["dataset", "plan", s(&bvh), "--mocap", s(&root)]);
+    assert!(out.contains("pose pool: 11 poses in 2 motions"), "{out}");
+    let err = fails(&[
+        "dataset",
+        "plan",
+        s(&repo().join("specs/tiny.toml")),
+        "--mocap",
+        s(dir.path()),
+    ]);
+    assert!(err.contains("02_01.amc"), "{err}");
+}
+
+#[test]
+fn generate_resume_merge_info_show() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let spec = d.join("fast.toml");
+    std::fs::write(&spec, FAST).unwrap();
+    let (a, b, whole) = (d.join("a"), d.join("b"), d.join("whole"));
+    // Job 0 of 2, interrupted after one sample, then resumed.
+    let out = ok(&[
+        "dataset",
+        "generate",
+        s(&spec),
+        "--out",
+        s(&a),
+        "--shard",
+        "0/2",
+        "--max-samples",
+        "1",
+    ]);
+    assert!(
+        out.contains("run the same command again to resume"),
+        "{out}"
+    );
+    let out = ok(&[
+        "dataset",
+        "generate",
+        s(&spec),
+        "--out",
+        s(&a),
+        "--shard",
+        "0/2",
+        "--jobs",
+        "2",
+    ]);
+    assert!(
+        out.contains("1 of 4 selected samples were already made"),
+        "{out}"
+    );
+    assert!(out.contains("merge the job folders"), "{out}");
+    ok(&[
+        "dataset",
+        "generate",
+        s(&spec),
+        "--out",
+        s(&b),
+        "--shard",
+        "1/2",
+        "--jobs",
+        "1",
+    ]);
+    let merged = d.join("merged");
+    let out = ok(&["dataset", "merge", s(&merged), s(&a), s(&b)]);
+    assert!(
+        out.contains("3 of 3 shards") && out.contains("complete"),
+        "{out}"
+    );
+    // The same dataset made in one go.
+    let out = ok(&["dataset", "generate", s(&spec), "--out", s(&whole)]);
+    assert!(out.contains("the dataset is complete"), "{out}");
+    for shard in 0..3 {
+        let name = format!("shards/shard-{shard:06}.safetensors");
+        let (x, y) = (
+            std::fs::read(merged.join(&name)),
+            std::fs::read(whole.join(&name)),
+        );
+        assert_eq!(x.unwrap(), y.unwrap(), "{name}");
+    }
+    let out = ok(&["dataset", "info", s(&merged), "--verify"]);
+    assert!(
+        out.contains("of 6 samples stored") && out.contains("tshirt ok/failed"),
+        "{out}"
+    );
+    assert!(
+        out.contains("drape time") && out.contains("verified: 3 shards"),
+        "{out}"
+    );
+    let json = ok(&["dataset", "info", s(&merged), "--json"]);
+    assert!(json.contains("\"total_samples\": 6"), "{json}");
+    // Show: the body, M and G of a stored sample.
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(merged.join("manifest.json")).unwrap())
+            .unwrap();
+    let k = manifest["samples"][0]["index"]
+        .as_u64()
+        .unwrap()
+        .to_string();
+    let png = d.join("show.png");
+    ok(&[
+        "dataset",
+        "show",
+        s(&merged),
+        "--index",
+        &k,
+        "--png",
+        s(&png),
+    ]);
+    let image = render::Image::from_png(&png).unwrap();
+    assert!(image.width >= 900 && image.count_not(image.pixel(0, 0)) > 20_000);
+    let err = fails(&[
+        "dataset",
+        "show",
+        s(&merged),
+        "--index",
+        "99",
+        "--png",
+        s(&png),
+    ]);
+    assert!(err.contains("sample 99 is not stored"), "{err}");
+    // A damaged shard is named.
+    let shard = merged.join("shards/shard-000002.safetensors");
+    let mut bytes = std::fs::read(&shard).unwrap();
+    let n = bytes.len();
+    bytes[n - 8] ^= 1;
+    std::fs::write(&shard, bytes).unwrap();
+    let err = fails(&["dataset", "info", s(&merged), "--verify"]);
+    assert!(
+        err.contains("shard-000002.safetensors") && err.contains("checksum"),
+        "{err}"
+    );
+    // Another spec in the same folder is refused.
+    std::fs::write(&spec, FAST.replace("seed = 9", "seed = 10")).unwrap();
+    let err = fails(&["dataset", "generate", s(&spec), "--out", s(&whole)]);
+    assert!(err.contains("another spec"), "{err}");
+    let err = fails(&[
+        "dataset",
+        "generate",
+        s(&spec),
+        "--out",
+        s(&whole),
+        "--shard",
+        "2/2",
+    ]);
+    assert!(err.contains("--shard"), "{err}");
+}

@@ -1,0 +1,204 @@
+//! Reading a dataset: the manifest, samples by index, templates and body faces, with
+//! every file's sha256 checked against the manifest when it is read. Shards are opened
+//! lazily and only the most recent few are kept in memory.
+
+use std::collections::{HashMap, VecDeque};
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+use garment::GarmentTemplate;
+
+use crate::error::{DatasetError, Result};
+use crate::hash::sha256_hex;
+use crate::manifest::{FileEntry, Manifest};
+use crate::records::SampleRecord;
+use crate::tensors::{self, SampleArrays};
+
+/// One stored sample: what it is and its arrays (shapes and units in
+/// [`crate::tensors`]; garment faces from [`Dataset::template`], body faces from
+/// [`Dataset::body_faces`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sample {
+    /// Index, garment, template id, body, split, pose and simulator statistics.
+    pub record: SampleRecord,
+    /// Body `[V,3]`, M `[N,3]`, G `[N,3]` (metres), phenotype `[11]`, pose.
+    pub arrays: SampleArrays,
+}
+
+/// A dataset folder opened for reading.
+pub struct Dataset {
+    dir: PathBuf,
+    manifest: Manifest,
+    cache_shards: usize,
+    shards: Mutex<VecDeque<(u64, Arc<Vec<u8>>)>>,
+    templates: Mutex<HashMap<String, Arc<GarmentTemplate>>>,
+}
+
+/// Reads `dir/rel` and checks its sha256.
+fn read_checked(dir: &Path, entry: &FileEntry) -> Result<Vec<u8>> {
+    let path = dir.join(&entry.file);
+    let bytes = std::fs::read(&path).map_err(|e| DatasetError::io(&path, e))?;
+    let actual = sha256_hex(&bytes);
+    if actual != entry.sha256 {
+        return Err(DatasetError::corrupt(
+            &path,
+            format!(
+                "checksum mismatch: the file's sha256 is {actual}, the manifest says {}; the file is damaged",
+                entry.sha256
+            ),
+        ));
+    }
+    Ok(bytes)
+}
+
+impl Dataset {
+    /// Opens the dataset in `dir`, keeping at most two shards in memory.
+    pub fn open(dir: &Path) -> Result<Self> {
+        Ok(Self {
+            manifest: Manifest::load(dir)?,
+            dir: dir.to_path_buf(),
+            cache_shards: 2,
+            shards: Mutex::new(VecDeque::new()),
+            templates: Mutex::new(HashMap::new()),
+        })
+    }
+
+    /// Keeps at most `n` (at least 1) shards in memory.
+    pub fn with_cache_shards(mut self, n: usize) -> Self {
+        self.cache_shards = n.max(1);
+        self
+    }
+
+    /// Shards kept in memory.
+    pub fn cache_shards(&self) -> usize {
+        self.cache_shards
+    }
+
+    /// The manifest.
+    pub fn manifest(&self) -> &Manifest {
+        &self.manifest
+    }
+
+    /// The dataset folder.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Indices of the stored samples of `split` and `garment` (`None`: any), ascending.
+    /// An unknown split or garment name is an error listing the known ones.
+    pub fn select(&self, split: Option<&str>, garment: Option<&str>) -> Result<Vec<u64>> {
+        let m = &self.manifest;
+        if let Some(s) = split.filter(|s| !m.splits.contains_key(*s)) {
+            let known: Vec<&str> = m.splits.keys().map(String::as_str).collect();
+            return Err(DatasetError::Invalid(format!(
+                "no split '{s}' (the splits are {})",
+                known.join(", ")
+            )));
+        }
+        if let Some(g) = garment.filter(|g| !m.garments.iter().any(|x| x.name == *g)) {
+            let known: Vec<&str> = m.garments.iter().map(|x| x.name.as_str()).collect();
+            return Err(DatasetError::Invalid(format!(
+                "no garment '{g}' (the garments are {})",
+                known.join(", ")
+            )));
+        }
+        Ok(m.samples
+            .iter()
+            .filter(|e| split.is_none_or(|s| e.record.split == s))
+            .filter(|e| garment.is_none_or(|g| e.record.garment == g))
+            .map(|e| e.record.index)
+            .collect())
+    }
+
+    /// The bytes of shard `s`, checked, from memory or disk.
+    fn shard_bytes(&self, s: u64) -> Result<Arc<Vec<u8>>> {
+        let mut cache = self.shards.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some(pos) = cache.iter().position(|(i, _)| *i == s) {
+            let hit = cache.remove(pos).expect("present");
+            cache.push_back(hit.clone());
+            return Ok(hit.1);
+        }
+        let entry = self
+            .manifest
+            .shard(s)
+            .ok_or_else(|| DatasetError::Invalid(format!("shard {s} is not in this dataset")))?;
+        let entry = FileEntry {
+            file: entry.file.clone(),
+            sha256: entry.sha256.clone(),
+        };
+        let bytes = Arc::new(read_checked(&self.dir, &entry)?);
+        cache.push_back((s, bytes.clone()));
+        while cache.len() > self.cache_shards {
+            cache.pop_front();
+        }
+        Ok(bytes)
+    }
+
+    /// Stored sample `k`. A sample that failed, was not made, or does not exist is an
+    /// error saying which; a damaged shard is an error naming its file.
+    pub fn sample(&self, k: u64) -> Result<Sample> {
+        let m = &self.manifest;
+        let Some(entry) = m.sample(k) else {
+            let why = match m.failures.iter().find(|f| f.record.index == k) {
+                Some(f) => format!("its drape failed: {}", f.record.reason),
+                None if k >= m.total_samples => {
+                    format!("the dataset has {} samples", m.total_samples)
+                }
+                None => "its shard is not in this folder".into(),
+            };
+            return Err(DatasetError::Invalid(format!(
+                "sample {k} is not stored: {why}"
+            )));
+        };
+        let bytes = self.shard_bytes(entry.shard)?;
+        let path = self.dir.join(crate::layout::shard_file(entry.shard));
+        let (st, _) = tensors::parse(&bytes, crate::shard::SHARD_KEY, &path)?;
+        Ok(Sample {
+            record: entry.record.clone(),
+            arrays: SampleArrays::read(&st, k, &path)?,
+        })
+    }
+
+    /// Template `id` (the garment faces and rest shape of samples that name it).
+    pub fn template(&self, id: &str) -> Result<Arc<GarmentTemplate>> {
+        let mut cache = self.templates.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some(t) = cache.get(id) {
+            return Ok(t.clone());
+        }
+        let entry = self
+            .manifest
+            .templates
+            .get(id)
+            .ok_or_else(|| DatasetError::Invalid(format!("no template '{id}'")))?;
+        read_checked(&self.dir, entry)?;
+        let t = Arc::new(GarmentTemplate::load(&self.dir.join(&entry.file))?);
+        cache.insert(id.to_string(), t.clone());
+        Ok(t)
+    }
+
+    /// The body faces `[F]` (vertex index triples into a sample's `body`).
+    pub fn body_faces(&self) -> Result<Vec<[u32; 3]>> {
+        let entry = self
+            .manifest
+            .body_faces
+            .as_ref()
+            .ok_or_else(|| DatasetError::Invalid("the manifest lists no body faces".into()))?;
+        let bytes = read_checked(&self.dir, entry)?;
+        crate::body_faces::parse(&bytes, &self.dir.join(&entry.file))
+    }
+
+    /// Reads every file the manifest lists and checks its sha256; returns the problems
+    /// found (none: the dataset is intact).
+    pub fn verify(&self) -> Vec<DatasetError> {
+        let m = &self.manifest;
+        let shards = m.shards.iter().map(|e| FileEntry {
+            file: e.file.clone(),
+            sha256: e.sha256.clone(),
+        });
+        let others = m.body_faces.iter().chain(m.templates.values()).cloned();
+        shards
+            .chain(others)
+            .filter_map(|e| read_checked(&self.dir, &e).err())
+            .collect()
+    }
+}

@@ -1,0 +1,100 @@
+//! The small records that describe samples and failures, shared by shard metadata, part
+//! files and the manifest.
+//!
+//! Everything in a [`SampleRecord`] or [`FailureRecord`] is a pure function of the spec
+//! and the sample index, so shards holding them are byte-identical between runs; wall
+//! times ([`Timing`]) are kept apart, in part files and the manifest only.
+
+use serde::{Deserialize, Serialize};
+use sim::stats::DrapeStats;
+
+/// The simulator's statistics of a drape, without its wall time (deterministic).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SimStats {
+    /// Steps of the body animation (shape morph, then pose).
+    pub animation_steps: u32,
+    /// Steps spent settling after the animation.
+    pub settle_steps: u32,
+    /// Kinetic energy at the end, joules.
+    pub final_kinetic_energy: f32,
+    /// Largest depth of a garment vertex inside the body, metres.
+    pub max_penetration_m: f32,
+    /// 99th percentile of the garment vertices' depths inside the body, metres.
+    pub p99_penetration_m: f32,
+    /// Median edge strain (length / rest - 1).
+    pub strain_p50: f32,
+    /// 90th percentile of the edge strain.
+    pub strain_p90: f32,
+    /// 99th percentile of the edge strain.
+    pub strain_p99: f32,
+    /// Largest edge strain.
+    pub strain_max: f32,
+    /// Whether the cloth came to rest within the step budget.
+    pub converged: bool,
+}
+
+impl From<&DrapeStats> for SimStats {
+    fn from(s: &DrapeStats) -> Self {
+        Self {
+            animation_steps: s.animation_steps,
+            settle_steps: s.settle_steps,
+            final_kinetic_energy: s.final_kinetic_energy,
+            max_penetration_m: s.max_penetration_m,
+            p99_penetration_m: s.p99_penetration_m,
+            strain_p50: s.strain_p50,
+            strain_p90: s.strain_p90,
+            strain_p99: s.strain_p99,
+            strain_max: s.strain_max,
+            converged: s.converged,
+        }
+    }
+}
+
+/// What a stored sample is.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SampleRecord {
+    /// Sample index in the plan.
+    pub index: u64,
+    /// Garment name.
+    pub garment: String,
+    /// Id of the template (file `templates/ID.garment`).
+    pub template: String,
+    /// Body index.
+    pub body: u32,
+    /// Split name.
+    pub split: String,
+    /// Pose id: `CLIP#FRAME` or `procedural[S]:KIND#DRAW`.
+    pub pose: String,
+    /// The body's stature, metres.
+    pub stature_m: f32,
+    /// The body's mass index, kg/m^2.
+    pub bmi: f32,
+    /// Simulator statistics.
+    pub stats: SimStats,
+}
+
+/// A sample whose drape failed: listed, never stored.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FailureRecord {
+    /// Sample index in the plan.
+    pub index: u64,
+    /// Garment name.
+    pub garment: String,
+    /// Body index.
+    pub body: u32,
+    /// Split name.
+    pub split: String,
+    /// Pose id.
+    pub pose: String,
+    /// Why it failed (the simulator's error, or a pose that could not be drawn).
+    pub reason: String,
+}
+
+/// Wall times of one sample on the machine that made it, seconds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Timing {
+    /// The whole sample: body, pose, template, drape, warp and writing.
+    pub sample_s: f64,
+    /// The drape alone (the simulator's `wall_time_s`; 0 if it failed early).
+    pub drape_s: f64,
+}

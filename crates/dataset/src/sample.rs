@@ -1,0 +1,154 @@
+//! Making one sample: the body of its index, its pose, its garment template, the drape
+//! (G) and the paper's warp (M).
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use body::shape_sampler::stature_and_bmi;
+use body::{BodyModel, ShapedBody, Skinning};
+use garment::warp::{warp, warp_fitted, SurfaceAnchors};
+use sim::drape::{drape, DrapeOptions};
+
+use crate::cache::KeyedCache;
+use crate::error::{DatasetError, Result};
+use crate::plan::{Plan, SampleDesc};
+use crate::poses::PoseLibrary;
+use crate::records::{FailureRecord, SampleRecord, SimStats, Timing};
+use crate::spec::Spec;
+use crate::templates::{TemplateError, TemplateStore};
+use crate::tensors::SampleArrays;
+
+/// A shaped body of the dataset, with its stature (m) and BMI (kg/m^2).
+pub type BodyEntry = Arc<(ShapedBody, f32, f32)>;
+
+/// Everything a worker needs to make samples.
+pub struct Maker<'a> {
+    /// The body model.
+    pub model: &'a BodyModel,
+    /// The template body (default phenotype, rest pose): where drapes start.
+    pub template_body: ShapedBody,
+    /// The spec.
+    pub spec: &'a Spec,
+    /// The plan.
+    pub plan: &'a Plan,
+    /// The clips.
+    pub library: &'a PoseLibrary,
+    /// Simulator settings.
+    pub drape_options: DrapeOptions,
+    /// Templates of the dataset folder.
+    pub templates: TemplateStore,
+    /// Recently shaped bodies.
+    pub bodies: KeyedCache<u32, std::result::Result<BodyEntry, String>>,
+}
+
+/// What became of a sample.
+pub enum Outcome {
+    /// Made: its record and arrays.
+    Done(Box<(SampleRecord, SampleArrays)>),
+    /// Not made, and why.
+    Failed(FailureRecord),
+}
+
+impl Maker<'_> {
+    /// Body `b` of the dataset: its shape drawn from the spec's distribution and solved
+    /// on the mesh.
+    pub fn body(&self, b: u32) -> Result<BodyEntry> {
+        self.bodies
+            .get_or_init(&b, || {
+                let dist = &self.spec.bodies.distribution;
+                let shape = dist
+                    .sample(self.model, self.plan.body_seed(b))
+                    .and_then(|s| self.model.shape(&s.phenotype))
+                    .map_err(|e| format!("body {b}: {e}"))?;
+                let (stature, bmi) = stature_and_bmi(&shape);
+                Ok(Arc::new((shape, stature, bmi)))
+            })
+            .map_err(|e| DatasetError::Body(body::BodyError::Parameter(e)))
+    }
+
+    /// Makes sample `desc`. A failed drape (or a pose or cut that cannot be made) is an
+    /// [`Outcome::Failed`]; errors are problems of the machine or the installation.
+    pub fn make(&self, desc: &SampleDesc) -> Result<(Outcome, Timing)> {
+        let start = Instant::now();
+        let garment = &self.plan.garments[desc.garment];
+        let pose_id = self.plan.pool.pose_id(desc.pose);
+        let split = self.plan.split_names[desc.split].clone();
+        let fail = |reason: String, drape_s: f64| {
+            let f = FailureRecord {
+                index: desc.index,
+                garment: garment.name.clone(),
+                body: desc.body,
+                split: split.clone(),
+                pose: pose_id.clone(),
+                reason,
+            };
+            let t = Timing {
+                sample_s: start.elapsed().as_secs_f64(),
+                drape_s,
+            };
+            Ok((Outcome::Failed(f), t))
+        };
+        let body = self.body(desc.body)?;
+        let (target, stature, bmi) = (&body.0, body.1, body.2);
+        let template =
+            match self
+                .templates
+                .get(self.model, self.plan.seed, desc.garment, garment, desc.body)
+            {
+                Ok(t) => t,
+                Err(TemplateError::Build(m)) => return fail(m, 0.0),
+                Err(TemplateError::Save(m)) => return Err(DatasetError::Invalid(m)),
+            };
+        let pose = match self
+            .library
+            .pose(self.spec, self.plan.pool.poses[desc.pose], target)
+        {
+            Ok(p) => p,
+            Err(m) => return fail(m, 0.0),
+        };
+        let opts = &self.drape_options;
+        let draped = match drape(
+            &template,
+            &self.template_body,
+            target,
+            &pose,
+            opts,
+            &mut |_, _, _| {},
+        ) {
+            Ok(d) => d,
+            Err(e) => return fail(format!("drape: {e}"), start.elapsed().as_secs_f64()),
+        };
+        let warped = warp(&template, target, &pose, Skinning::Dqs)?;
+        let fitted = if self.spec.output.fitted {
+            let anchors = SurfaceAnchors::new(&template.mesh, &self.template_body.mesh)?;
+            Some(warp_fitted(&template, &anchors, target, &pose, Skinning::Dqs)?.vertices)
+        } else {
+            None
+        };
+        let record = SampleRecord {
+            index: desc.index,
+            garment: garment.name.clone(),
+            template: garment.template_id(desc.body),
+            body: desc.body,
+            split,
+            pose: pose_id,
+            stature_m: stature,
+            bmi,
+            stats: SimStats::from(&draped.stats),
+        };
+        let arrays = SampleArrays {
+            body: draped.body.vertices,
+            warped: warped.vertices,
+            draped: draped.garment.vertices,
+            fitted,
+            phenotype: target.phenotype.named_values().map(|(_, v)| v).to_vec(),
+            root_translation: pose.root_translation,
+            rotations: pose.rotations,
+        };
+        let timing = Timing {
+            sample_s: start.elapsed().as_secs_f64(),
+            drape_s: draped.stats.wall_time_s,
+        };
+        Ok((Outcome::Done(Box::new((record, arrays))), timing))
+    }
+}

@@ -1,0 +1,118 @@
+//! Turning the spec's `[simulator]` overrides into the simulator's drape options.
+
+use body::Skinning;
+use sim::drape::DrapeOptions;
+
+use crate::spec::SimulatorSpec;
+
+impl SimulatorSpec {
+    /// The drape options: the simulator's defaults with this spec's overrides. Errors are
+    /// `(field, message)` with the field named as in the spec.
+    pub fn drape_options(&self) -> Result<DrapeOptions, (String, String)> {
+        let mut o = DrapeOptions::default();
+        let c = &mut o.cloth;
+        let set = |dst: &mut f32, v: Option<f32>| {
+            if let Some(v) = v {
+                *dst = v;
+            }
+        };
+        set(&mut c.density, self.density);
+        set(&mut c.stretch_stiffness, self.stretch_stiffness);
+        set(&mut c.bend_stiffness, self.bend_stiffness);
+        set(&mut c.damping, self.damping);
+        set(&mut c.friction, self.friction);
+        set(&mut c.thickness, self.thickness);
+        set(&mut c.contact_margin, self.contact_margin);
+        set(&mut c.dt, self.dt);
+        set(&mut c.chebyshev_rho, self.chebyshev_rho);
+        c.iterations = self.iterations.unwrap_or(c.iterations);
+        o.morph_steps = self.morph_steps.unwrap_or(o.morph_steps);
+        o.pose_steps = self.pose_steps.unwrap_or(o.pose_steps);
+        o.max_settle_steps = self.max_settle_steps.unwrap_or(o.max_settle_steps);
+        set(&mut o.rest_speed, self.rest_speed);
+        set(&mut o.explode_speed, self.explode_speed);
+        set(&mut o.max_penetration, self.max_penetration);
+        o.grade = self.grade.unwrap_or(o.grade);
+        if let Some(s) = &self.skinning {
+            o.skinning = match s.to_ascii_lowercase().as_str() {
+                "dqs" => Skinning::Dqs,
+                "lbs" => Skinning::Lbs,
+                _ => {
+                    return Err((
+                        "skinning".into(),
+                        format!("'{s}' is not a skinning method (dqs or lbs)"),
+                    ))
+                }
+            };
+        }
+        if let Err(e) = o.cloth.validate() {
+            let text = e.to_string();
+            // The simulator's message starts with the field name after its prefix.
+            let field = text
+                .trim_start_matches("invalid parameter: ")
+                .split_whitespace()
+                .next()
+                .unwrap_or("")
+                .to_string();
+            return Err((field, text));
+        }
+        for (name, v) in [("morph_steps", o.morph_steps), ("pose_steps", o.pose_steps)] {
+            if v == 0 {
+                return Err((name.into(), "must be at least 1".into()));
+            }
+        }
+        let positive = [
+            ("rest_speed", o.rest_speed),
+            ("explode_speed", o.explode_speed),
+        ];
+        for (name, v) in positive {
+            if !(v.is_finite() && v > 0.0) {
+                return Err((name.into(), format!("must be positive and finite, got {v}")));
+            }
+        }
+        if !(o.max_penetration.is_finite() && o.max_penetration >= 0.0) {
+            return Err((
+                "max_penetration".into(),
+                format!("must be non-negative metres, got {}", o.max_penetration),
+            ));
+        }
+        Ok(o)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn overrides_apply_and_bad_values_name_the_field() {
+        let s = SimulatorSpec {
+            iterations: Some(4),
+            max_settle_steps: Some(10),
+            friction: Some(0.2),
+            skinning: Some("LBS".into()),
+            ..Default::default()
+        };
+        let o = s.drape_options().unwrap();
+        assert_eq!(o.cloth.iterations, 4);
+        assert_eq!(o.max_settle_steps, 10);
+        assert_eq!(o.cloth.friction, 0.2);
+        assert_eq!(o.skinning, Skinning::Lbs);
+        assert_eq!(o.pose_steps, DrapeOptions::default().pose_steps);
+        let bad = SimulatorSpec {
+            density: Some(-1.0),
+            ..Default::default()
+        };
+        assert_eq!(bad.drape_options().unwrap_err().0, "density");
+        let bad = SimulatorSpec {
+            iterations: Some(0),
+            ..Default::default()
+        };
+        assert_eq!(bad.drape_options().unwrap_err().0, "iterations");
+        let bad = SimulatorSpec {
+            rest_speed: Some(0.0),
+            ..Default::default()
+        };
+        assert_eq!(bad.drape_options().unwrap_err().0, "rest_speed");
+    }
+}
