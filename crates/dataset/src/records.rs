@@ -31,6 +31,9 @@ pub struct SimStats {
     pub strain_max: f32,
     /// Whether the cloth came to rest within the step budget.
     pub converged: bool,
+    /// The largest turn of a limb joint by the pose's clearance correction, degrees.
+    #[serde(default)]
+    pub limb_turn_deg: f32,
 }
 
 impl From<&DrapeStats> for SimStats {
@@ -46,6 +49,7 @@ impl From<&DrapeStats> for SimStats {
             strain_p99: s.strain_p99,
             strain_max: s.strain_max,
             converged: s.converged,
+            limb_turn_deg: s.limb_turn_deg,
         }
     }
 }

@@ -118,10 +118,13 @@ impl Maker<'_> {
             Ok(d) => d,
             Err(e) => return fail(format!("drape: {e}"), start.elapsed().as_secs_f64()),
         };
-        let warped = warp(&template, target, &pose, Skinning::Dqs)?;
+        // The drape may have corrected the pose (limb clearance): M, G, the body and the
+        // stored pose parameters all use the pose the body actually took.
+        let pose = &draped.pose;
+        let warped = warp(&template, target, pose, Skinning::Dqs)?;
         let fitted = if self.spec.output.fitted {
             let anchors = SurfaceAnchors::new(&template.mesh, &self.template_body.mesh)?;
-            Some(warp_fitted(&template, &anchors, target, &pose, Skinning::Dqs)?.vertices)
+            Some(warp_fitted(&template, &anchors, target, pose, Skinning::Dqs)?.vertices)
         } else {
             None
         };
@@ -143,7 +146,7 @@ impl Maker<'_> {
             fitted,
             phenotype: target.phenotype.named_values().map(|(_, v)| v).to_vec(),
             root_translation: pose.root_translation,
-            rotations: pose.rotations,
+            rotations: pose.rotations.clone(),
         };
         let timing = Timing {
             sample_s: start.elapsed().as_secs_f64(),
