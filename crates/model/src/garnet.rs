@@ -1,0 +1,141 @@
+//! GarNet: body stream + garment stream + fusion; predicts per-vertex translations of the
+//! warped garment M and returns `G = M + T` (paper eq. 1).
+
+use burn::prelude::*;
+
+use crate::body_stream::{BodyStream, LocalPool};
+use crate::config::{GarNetConfig, Variant};
+use crate::error::{ModelError, Result};
+use crate::fusion::Fusion;
+use crate::garment_stream::GarmentStream;
+use crate::init::ParamInit;
+use crate::local::LocalIndices;
+use crate::topology::TopologyTensors;
+
+/// The GarNet network (any of the three variants, see [`GarNet::variant`]).
+#[derive(Module, Debug)]
+pub struct GarNet {
+    /// PointNet body stream.
+    pub body: BodyStream,
+    /// Garment stream (with mesh convolutions unless Naive).
+    pub garment: GarmentStream,
+    /// Local body pooling (GarNet-Local only).
+    pub local: Option<LocalPool>,
+    /// Fusion network.
+    pub fusion: Fusion,
+}
+
+impl GarNetConfig {
+    /// Builds the network on `device` with seeded initial values (same config and seed, same
+    /// parameters). Fails when the config does not [`validate`](GarNetConfig::validate).
+    pub fn init(&self, device: &Device) -> Result<GarNet> {
+        self.validate()?;
+        let mut init = ParamInit::new(self.seed);
+        let body = BodyStream::new(self, &mut init, device);
+        let garment = GarmentStream::new(self, &mut init, device);
+        let local = self
+            .variant
+            .has_local()
+            .then(|| LocalPool::new(self, &mut init, device));
+        let mut d_vertex = self.garment_point_width();
+        if self.variant.has_mesh_conv() {
+            d_vertex += self.conv_width;
+        }
+        if self.variant.has_local() {
+            d_vertex += self.local_width;
+        }
+        let d_global = self.garment_global + self.body_feature_width();
+        let fusion = Fusion::new(d_vertex, d_global, &self.fusion, &mut init, device);
+        Ok(GarNet {
+            body,
+            garment,
+            local,
+            fusion,
+        })
+    }
+}
+
+impl GarNet {
+    /// The variant, read from the structure (local pooling: Local; mesh convolutions:
+    /// Global; neither: Naive).
+    pub fn variant(&self) -> Variant {
+        if self.local.is_some() {
+            Variant::Local
+        } else if self.garment.blocks.is_empty() {
+            Variant::Naive
+        } else {
+            Variant::Global
+        }
+    }
+
+    /// Predicted translations `T` `[B,N,3]` (metres).
+    ///
+    /// - `body`: the body points the stream sees `[B,P,3]` (see
+    ///   [`crate::local::BodySampling::stream_points`]), metres.
+    /// - `warped`: the DQS-warped garment M `[B,N,3]`, metres.
+    /// - `topo`: the garment template's connectivity (N vertices).
+    /// - `local`: the batch's neighbour tables; required by GarNet-Local, ignored otherwise.
+    pub fn translations(
+        &self,
+        body: Tensor<3>,
+        warped: Tensor<3>,
+        topo: &TopologyTensors,
+        local: Option<&LocalIndices>,
+    ) -> Result<Tensor<3>> {
+        let [b, v, cb] = body.dims();
+        let [bm, n, cm] = warped.dims();
+        if cb != 3 || cm != 3 || b != bm || b == 0 || v == 0 {
+            return Err(ModelError::InvalidInput(format!(
+                "GarNet takes body [B,P,3] and M [B,N,3] with B, P > 0, got [{b},{v},{cb}] and \
+                 [{bm},{n},{cm}]"
+            )));
+        }
+        if n != topo.n_vertices {
+            return Err(ModelError::VertexCount {
+                what: "warped garment M".into(),
+                expected: topo.n_vertices,
+                got: n,
+            });
+        }
+        let body_features = self.body.forward(body);
+        let garment = self
+            .garment
+            .forward(warped, body_features.global.clone(), topo);
+        let mut per_vertex = vec![garment.points];
+        if let Some(p) = garment.patches {
+            per_vertex.push(p);
+        }
+        if let Some(pool) = &self.local {
+            let idx = local.ok_or_else(|| {
+                ModelError::InvalidInput("GarNet-Local needs the batch's local tables".into())
+            })?;
+            if idx.n_garment != n || idx.pool.dims()[0] != b * idx.n_centres * idx.pool_k {
+                return Err(ModelError::InvalidInput(format!(
+                    "local tables are for {} garment vertices and another batch size",
+                    idx.n_garment
+                )));
+            }
+            per_vertex.push(pool.forward(body_features.points, idx));
+        }
+        let per_vertex = if per_vertex.len() == 1 {
+            per_vertex.pop().expect("one element")
+        } else {
+            Tensor::cat(per_vertex, 2)
+        };
+        let global = Tensor::cat(vec![garment.global, body_features.global], 1);
+        Ok(self.fusion.forward(per_vertex, global))
+    }
+
+    /// The predicted draped garment `G = M + T` `[B,N,3]` (metres); arguments as
+    /// [`GarNet::translations`].
+    pub fn forward(
+        &self,
+        body: Tensor<3>,
+        warped: Tensor<3>,
+        topo: &TopologyTensors,
+        local: Option<&LocalIndices>,
+    ) -> Result<Tensor<3>> {
+        let t = self.translations(body, warped.clone(), topo, local)?;
+        Ok(warped + t)
+    }
+}
