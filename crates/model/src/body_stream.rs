@@ -107,3 +107,92 @@ impl LocalPool {
         acc.reshape([b, n, l])
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::local::BodySampling;
+    use crate::synthetic::{ellipsoid_body, tube_garment};
+    use crate::tensors::{read_f32, vec_tensor};
+    use rand::{Rng, SeedableRng};
+
+    /// Local pooling against loops over the tables, for a batch of two different bodies.
+    #[test]
+    fn local_pool_matches_a_plain_loop() {
+        let device = Device::flex();
+        let cfg = GarNetConfig::tiny(crate::Variant::Local);
+        let mut init = ParamInit::new(9);
+        let pool = LocalPool::new(&cfg, &mut init, &device);
+        let (body, _) = ellipsoid_body(200);
+        let sampling = BodySampling::farthest_point(&body, 2, 4).unwrap();
+        let garment = tube_garment(30).vertices;
+        let streams: Vec<Vec<glam::Vec3>> = [1.0f32, 1.2]
+            .iter()
+            .map(|s| {
+                sampling
+                    .stream_points(&body)
+                    .unwrap()
+                    .iter()
+                    .map(|p| *p * *s)
+                    .collect()
+            })
+            .collect();
+        let refs: Vec<&[glam::Vec3]> = streams.iter().map(Vec::as_slice).collect();
+        let (pk, kk) = (cfg.pool_neighbours, cfg.local_neighbours);
+        let idx =
+            LocalIndices::build(&sampling, pk, kk, &refs, &[&garment, &garment], &device).unwrap();
+        let (b, p, c) = (2, sampling.len(), cfg.body_feature_width());
+        let mut rng = rand::rngs::StdRng::seed_from_u64(1);
+        let feats: Vec<f32> = (0..b * p * c)
+            .map(|_| rng.random_range(-1.0..1.0))
+            .collect();
+        let got = pool.forward(vec_tensor(feats.clone(), [b, p, c], &device), &idx);
+        let n = garment.len();
+        let l = cfg.local_width;
+        assert_eq!(got.dims(), [b, n, l]);
+        let got = read_f32(got).unwrap();
+        let w = read_f32(pool.proj.weight.val()).unwrap();
+        let bias = read_f32(pool.proj.bias.as_ref().unwrap().val()).unwrap();
+        for (bi, stream) in refs.iter().enumerate() {
+            let (pt, kt) = sampling.tables(stream, &garment, pk, kk).unwrap();
+            let s = sampling.n_centres;
+            let kept: Vec<Vec<f64>> = (0..s)
+                .map(|ci| {
+                    let mean: Vec<f64> = (0..c)
+                        .map(|f| {
+                            pt[ci * pk..(ci + 1) * pk]
+                                .iter()
+                                .map(|&j| feats[(bi * p + j as usize) * c + f] as f64)
+                                .sum::<f64>()
+                                / pk as f64
+                        })
+                        .collect();
+                    (0..l)
+                        .map(|o| {
+                            let z = bias[o] as f64
+                                + (0..c).map(|f| mean[f] * w[f * l + o] as f64).sum::<f64>();
+                            if z > 0.0 {
+                                z
+                            } else {
+                                0.1 * z
+                            }
+                        })
+                        .collect()
+                })
+                .collect();
+            for v in 0..n {
+                for o in 0..l {
+                    let want = kt[v * kk..(v + 1) * kk]
+                        .iter()
+                        .map(|&ci| kept[ci as usize][o])
+                        .fold(f64::MIN, f64::max);
+                    let g = got[(bi * n + v) * l + o] as f64;
+                    assert!(
+                        (g - want).abs() < 1e-5,
+                        "sample {bi} vertex {v}: {g} vs {want}"
+                    );
+                }
+            }
+        }
+    }
+}

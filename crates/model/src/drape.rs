@@ -23,6 +23,16 @@ pub struct Draper {
     device: Device,
 }
 
+impl std::fmt::Debug for Draper {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Draper")
+            .field("variant", &self.setup.config.variant)
+            .field("n_garment", &self.topology.n_vertices)
+            .field("n_body", &self.setup.body_sampling.n_body)
+            .finish()
+    }
+}
+
 impl Draper {
     /// Wraps `model` with its `setup`, on `device` (the model is moved there, without
     /// autodiff). Fails when the model and the setup disagree.

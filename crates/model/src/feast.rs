@@ -102,3 +102,124 @@ impl FeaStConv {
         num * (ring_weight.clone() / den)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tensors::{read_f32, vec_tensor};
+    use crate::topology::GarmentTopology;
+    use rand::{Rng, SeedableRng};
+
+    /// FeaStNet written as loops over vertices, neighbours and heads, in f64, with the
+    /// layer's own parameters: `x` `[B][N][d_in]` -> `[B][N][d_out]`.
+    fn reference(
+        conv: &FeaStConv,
+        mesh: &geom::TriMesh,
+        x: &[Vec<Vec<f64>>],
+    ) -> Vec<Vec<Vec<f64>>> {
+        let u = read_f32(conv.u.weight.val()).unwrap(); // [d_in, M]
+        let c = read_f32(conv.c.val()).unwrap(); // [M]
+        let w = read_f32(conv.w.weight.val()).unwrap(); // [d_in*M, d_out]
+        let bias = read_f32(conv.w.bias.as_ref().unwrap().val()).unwrap();
+        let m = c.len();
+        let d_out = bias.len();
+        let d_in = u.len() / m;
+        let rings = geom::adjacency::one_ring(mesh.num_vertices(), &mesh.faces).unwrap();
+        x.iter()
+            .map(|xb| {
+                (0..xb.len())
+                    .map(|i| {
+                        let mut nbhd = vec![i];
+                        nbhd.extend(rings.row(i).iter().map(|&j| j as usize));
+                        let mut y: Vec<f64> = bias.iter().map(|&v| v as f64).collect();
+                        for &j in &nbhd {
+                            let logits: Vec<f64> = (0..m)
+                                .map(|h| {
+                                    (0..d_in)
+                                        .map(|f| u[f * m + h] as f64 * (xb[j][f] - xb[i][f]))
+                                        .sum::<f64>()
+                                        + c[h] as f64
+                                })
+                                .collect();
+                            let mx = logits.iter().cloned().fold(f64::MIN, f64::max);
+                            let z: f64 = logits.iter().map(|l| (l - mx).exp()).sum();
+                            for h in 0..m {
+                                let q = (logits[h] - mx).exp() / z / nbhd.len() as f64;
+                                for (o, yo) in y.iter_mut().enumerate() {
+                                    let wx: f64 = (0..d_in)
+                                        .map(|f| w[(f * m + h) * d_out + o] as f64 * xb[j][f])
+                                        .sum();
+                                    *yo += q * wx;
+                                }
+                            }
+                        }
+                        y
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn feast_conv_matches_a_plain_loop() {
+        let device = Device::flex();
+        // A 5x4 grid: vertex degrees 2 to 6, so rows are padded differently.
+        let mesh = geom::TriMesh::grid(5, 4, 0.1);
+        let topo = GarmentTopology::from_mesh(&mesh).unwrap();
+        let tt = topo.to_device(&device);
+        let (b, n, d_in, d_out, heads) = (2, mesh.num_vertices(), 5, 4, 3);
+        let mut init = ParamInit::new(11);
+        let mut conv = FeaStConv::new(d_in, d_out, heads, &mut init, &device);
+        conv.c = init.vector(heads, 1.0, &device);
+        let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+        let x: Vec<Vec<Vec<f64>>> = (0..b)
+            .map(|_| {
+                (0..n)
+                    .map(|_| (0..d_in).map(|_| rng.random_range(-2.0..2.0)).collect())
+                    .collect()
+            })
+            .collect();
+        let flat: Vec<f32> = x.iter().flatten().flatten().map(|&v| v as f32).collect();
+        let y = conv.forward(
+            vec_tensor(flat, [b, n, d_in], &device),
+            &tt.ring,
+            &tt.ring_weight,
+        );
+        assert_eq!(y.dims(), [b, n, d_out]);
+        let got = read_f32(y).unwrap();
+        let want: Vec<f64> = reference(&conv, &mesh, &x)
+            .into_iter()
+            .flatten()
+            .flatten()
+            .collect();
+        let worst = got
+            .iter()
+            .zip(&want)
+            .map(|(g, w)| (*g as f64 - w).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-5, "largest difference {worst}");
+    }
+
+    #[test]
+    fn assignments_are_a_softmax_even_with_large_logits() {
+        let device = Device::flex();
+        let mesh = geom::TriMesh::grid(3, 3, 1.0);
+        let topo = GarmentTopology::from_mesh(&mesh).unwrap();
+        let tt = topo.to_device(&device);
+        let mut init = ParamInit::new(5);
+        let conv = FeaStConv::new(3, 2, 4, &mut init, &device);
+        // Features of size ~30 give logits spanning tens: a plain exp would overflow.
+        let x: Vec<f32> = (0..9 * 3)
+            .map(|i| ((i * 37) % 11) as f32 * 6.0 - 30.0)
+            .collect();
+        let q = conv.assignment(vec_tensor(x, [1, 9, 3], &device), &tt.ring, &tt.ring_weight);
+        let q = read_f32(q).unwrap();
+        let k = topo.ring_width;
+        for (row, w) in q.chunks_exact(4).zip(&topo.ring_weight) {
+            let s: f32 = row.iter().sum();
+            assert!(row.iter().all(|v| v.is_finite() && *v >= 0.0));
+            assert!((s - w).abs() < 1e-5, "heads sum to {s}, expected {w}");
+        }
+        assert_eq!(q.len(), 9 * k * 4);
+    }
+}

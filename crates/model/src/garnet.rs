@@ -139,3 +139,118 @@ impl GarNet {
         Ok(warped + t)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Parameters of a fully connected layer.
+    fn fc(i: usize, o: usize, bias: bool) -> usize {
+        i * o + if bias { o } else { 0 }
+    }
+
+    fn mlp(d: usize, widths: &[usize]) -> (usize, usize) {
+        let mut total = 0;
+        let mut d = d;
+        for &w in widths {
+            total += fc(d, w, true);
+            d = w;
+        }
+        (total, d)
+    }
+
+    fn stn(k: usize, c: &GarNetConfig) -> usize {
+        let (mut total, d) = mlp(k, &c.stn_mlp);
+        let (fcs, d) = mlp(d, &c.stn_fc);
+        total += fcs + fc(d, k * k, true);
+        total
+    }
+
+    /// The parameter count written out from the architecture of section 3.2, independently
+    /// of the module code.
+    fn expected_params(c: &GarNetConfig) -> usize {
+        let cb = c.body_feature_width();
+        let (m1, c1) = mlp(3, &c.body_mlp1);
+        let (m2, _) = mlp(c1 + 3, &c.body_mlp2);
+        let body = stn(3, c) + m1 + stn(c1, c) + m2;
+        let mut garment = stn(3, c);
+        let mut d = 3;
+        for &w in &c.garment_mlp {
+            garment += fc(d, w, true) + fc(cb, w, false);
+            d = w;
+        }
+        let p = d;
+        let mut d_vertex = p;
+        let mut d_global_in = p;
+        if c.variant.has_mesh_conv() {
+            let w = c.conv_width;
+            if p != w {
+                garment += fc(p, w, true);
+            }
+            let feast =
+                fc(w + 3, c.conv_heads, false) + c.conv_heads + fc((w + 3) * c.conv_heads, w, true);
+            garment += c.conv_blocks * c.convs_per_block * feast;
+            d_vertex += w;
+            d_global_in += w;
+        }
+        garment += fc(d_global_in, c.garment_global, true);
+        let mut local = 0;
+        if c.variant.has_local() {
+            local = fc(cb, c.local_width, true);
+            d_vertex += c.local_width;
+        }
+        let h = &c.fusion;
+        let mut fusion = fc(d_vertex, h[0], true) + fc(c.garment_global + cb, h[0], false);
+        let (hidden, last) = mlp(h[0], &h[1..]);
+        fusion += hidden + fc(last, 3, true);
+        body + garment + local + fusion
+    }
+
+    #[test]
+    fn parameter_counts_follow_the_architecture() {
+        let device = Device::flex();
+        let mut counts = Vec::new();
+        for variant in Variant::ALL {
+            for cfg in [GarNetConfig::new(variant), GarNetConfig::tiny(variant)] {
+                let model = cfg.init(&device).unwrap();
+                assert_eq!(model.variant(), variant);
+                assert_eq!(model.num_params(), expected_params(&cfg), "{variant:?}");
+            }
+            let n = GarNetConfig::new(variant)
+                .init(&device)
+                .unwrap()
+                .num_params();
+            println!("GarNet-{}: {n} parameters (default widths)", variant.name());
+            counts.push(n);
+        }
+        // Local > Global > Naive.
+        assert!(counts[0] > counts[1] && counts[1] > counts[2]);
+    }
+
+    #[test]
+    fn naive_has_no_mesh_convolution() {
+        let device = Device::flex();
+        let naive = GarNetConfig::new(Variant::Naive).init(&device).unwrap();
+        assert!(naive.garment.blocks.is_empty());
+        assert!(naive.garment.conv_in.is_none());
+        assert!(naive.local.is_none());
+        let global = GarNetConfig::new(Variant::Global).init(&device).unwrap();
+        assert_eq!(global.garment.blocks.len(), 6);
+        assert!(GarNetConfig::new(Variant::Global)
+            .with_conv_blocks(0)
+            .init(&device)
+            .is_err());
+    }
+
+    #[test]
+    fn same_seed_same_parameters() {
+        let device = Device::flex();
+        let cfg = GarNetConfig::tiny(Variant::Local).with_seed(42);
+        let a = cfg.init(&device).unwrap();
+        let b = cfg.init(&device).unwrap();
+        let c = cfg.clone().with_seed(43).init(&device).unwrap();
+        let w = |m: &GarNet| crate::tensors::read_f32(m.fusion.first.point.weight.val()).unwrap();
+        assert_eq!(w(&a), w(&b));
+        assert_ne!(w(&a), w(&c));
+    }
+}

@@ -197,3 +197,75 @@ impl LocalIndices {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::synthetic::ellipsoid_body;
+
+    #[test]
+    fn farthest_point_sampling_covers_the_body_evenly() {
+        let (body, _) = ellipsoid_body(600);
+        let s = BodySampling::farthest_point(&body, 4, 5).unwrap();
+        assert_eq!(s.len(), 150);
+        assert_eq!(s.n_centres, 30);
+        assert_eq!(s.stream[0], 0);
+        let mut sorted = s.stream.clone();
+        sorted.sort_unstable();
+        sorted.dedup();
+        assert_eq!(sorted.len(), 150, "indices are distinct");
+        s.validate().unwrap();
+        // Farthest-point property: every body point is within the smallest separation of
+        // the chosen points (the covering radius never exceeds the packing distance).
+        let chosen = s.stream_points(&body).unwrap();
+        let min_sep = (0..chosen.len())
+            .flat_map(|i| (0..i).map(move |j| (i, j)))
+            .map(|(i, j)| chosen[i].distance(chosen[j]))
+            .fold(f32::MAX, f32::min);
+        let cover = body
+            .iter()
+            .map(|p| {
+                chosen
+                    .iter()
+                    .map(|c| p.distance(*c))
+                    .fold(f32::MAX, f32::min)
+            })
+            .fold(0.0f32, f32::max);
+        assert!(
+            cover <= min_sep + 1e-6,
+            "cover {cover} > separation {min_sep}"
+        );
+        // The kept prefix is itself a farthest-point sample.
+        let kept = &chosen[..s.n_centres];
+        let again = BodySampling::farthest_point(&body, 20, 1).unwrap();
+        assert_eq!(again.stream[..], s.stream[..s.n_centres]);
+        assert_eq!(kept.len(), 30);
+    }
+
+    #[test]
+    fn tables_are_the_nearest_neighbours() {
+        let (body, _) = ellipsoid_body(300);
+        let s = BodySampling::farthest_point(&body, 2, 5).unwrap();
+        let stream = s.stream_points(&body).unwrap();
+        let garment = crate::synthetic::tube_garment(40).vertices;
+        let (pool, knn) = s.tables(&stream, &garment, 4, 3).unwrap();
+        let centres = &stream[..s.n_centres];
+        let want_pool = geom::knn::knn_brute(&stream, centres, 4).unwrap();
+        let want_knn = geom::knn::knn_brute(centres, &garment, 3).unwrap();
+        // Compare distances (indices may differ only between equidistant points).
+        for (q, c) in centres.iter().enumerate() {
+            for (a, &i) in pool[q * 4..q * 4 + 4].iter().enumerate() {
+                let d = stream[i as usize].distance_squared(*c);
+                assert!((d - want_pool.sq_row(q)[a]).abs() < 1e-9);
+            }
+        }
+        for (q, g) in garment.iter().enumerate() {
+            for (a, &i) in knn[q * 3..q * 3 + 3].iter().enumerate() {
+                let d = centres[i as usize].distance_squared(*g);
+                assert!((d - want_knn.sq_row(q)[a]).abs() < 1e-9);
+            }
+        }
+        assert!(s.tables(&stream, &garment, 4, s.n_centres + 1).is_err());
+        assert!(s.stream_points(&body[..299]).is_err());
+    }
+}

@@ -284,3 +284,244 @@ pub fn garnet_loss(
         bend,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::batch::{InputSpec, Sample};
+    use crate::local::BodySampling;
+    use crate::tensors::{points_tensor, read_scalar};
+    use crate::topology::GarmentTopology;
+
+    /// Two triangles over the unit square (target G), faces [0,1,2] and [0,2,3]; the only
+    /// two-ring pair is (1, 3).
+    fn square() -> geom::TriMesh {
+        geom::TriMesh::new(
+            vec![
+                Vec3::new(0.0, 0.0, 0.0),
+                Vec3::new(1.0, 0.0, 0.0),
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::new(0.0, 1.0, 0.0),
+            ],
+            vec![[0, 1, 2], [0, 2, 3]],
+        )
+    }
+
+    /// The prediction: vertex 2 lifted by 1 m, vertex 3 moved by 0.5 m along y.
+    fn prediction() -> Vec<Vec3> {
+        let mut p = square().vertices;
+        p[2].z += 1.0;
+        p[3].y += 0.5;
+        p
+    }
+
+    /// A batch of one sample over the square with a two-vertex body 1 cm below it (normals
+    /// +z, mean edge 0.1 m, so pushed 2 cm out to z = +0.01).
+    fn batch(device: &Device) -> (Batch, TopologyTensors) {
+        let mesh = square();
+        let topo = GarmentTopology::from_mesh(&mesh).unwrap();
+        let sample = Sample {
+            body: vec![Vec3::new(0.0, 0.0, -0.01), Vec3::new(1.0, 0.9, -0.01)],
+            body_normals: vec![Vec3::Z, Vec3::Z],
+            body_edge: 0.1,
+            warped: mesh.vertices.clone(),
+            target: Some(mesh.vertices.clone()),
+        };
+        let spec = InputSpec {
+            sampling: BodySampling {
+                n_body: 2,
+                stream: vec![0, 1],
+                n_centres: 1,
+            },
+            local: None,
+        };
+        let b = Batch::new(&[sample], &topo, &spec, device).unwrap();
+        (b, topo.to_device(device))
+    }
+
+    fn close(a: f32, b: f64) {
+        assert!((a as f64 - b).abs() < 1e-6, "{a} != {b}");
+    }
+
+    #[test]
+    fn each_term_matches_its_hand_computed_value() {
+        let device = Device::flex();
+        let (b, topo) = batch(&device);
+        let pred = points_tensor(&[&prediction()], &device);
+        let target = b.target.clone().unwrap();
+        // (0 + 0 + 1 + 0.25) / 4
+        close(
+            read_scalar(vertex_loss(pred.clone(), target.clone())).unwrap(),
+            0.3125,
+        );
+        // Both faces tilt to normals (0,-1,1)/sqrt2 and (-1,0,1)/sqrt2: (1 - 1/sqrt2)^2 each.
+        let tilt = (1.0 - 0.5f64.sqrt()).powi(2);
+        close(
+            read_scalar(normal_loss(pred.clone(), target.clone(), &topo.faces)).unwrap(),
+            tilt,
+        );
+        // Pair (1,3): |(1,-1.5,0)| - |(1,-1,0)| = sqrt(3.25) - sqrt(2).
+        let bend = 3.25f64.sqrt() - 2f64.sqrt();
+        close(
+            read_scalar(bending_loss(pred.clone(), target.clone(), &topo.bend_pairs)).unwrap(),
+            bend,
+        );
+        // Vertices 0 and 1 sit at z = 0, 1 cm under their pushed body points (z = 0.01):
+        // 0.01 each; vertices 2 and 3 are > d_tol from their targets and do not count.
+        let cfg = LossConfig::new();
+        let all = garnet_loss(pred, &b, &topo, &cfg)
+            .unwrap()
+            .values()
+            .unwrap();
+        close(all.pen, 0.02 / 4.0);
+        close(all.vertex, 0.3125);
+        close(all.norm, tilt);
+        close(all.bend, bend);
+        close(all.total, 0.3125 + 0.005 + 0.3 * tilt + 0.5 * bend);
+    }
+
+    #[test]
+    fn penetration_counts_only_close_vertices_on_the_wrong_side() {
+        let device = Device::flex();
+        let (b, topo) = batch(&device);
+        let cfg = LossConfig::new();
+        // Vertex 0 3 cm up (within d_tol, 2 cm outside its pushed body point), vertices 2 and
+        // 3 2 cm up (1 cm outside): no penalty; vertex 1 stays 1 cm inside: 0.01 / 4.
+        let mut p = square().vertices;
+        p[0].z = 0.03;
+        p[2].z = 0.02;
+        p[3].z = 0.02;
+        let pen = garnet_loss(points_tensor(&[&p], &device), &b, &topo, &cfg)
+            .unwrap()
+            .values()
+            .unwrap()
+            .pen;
+        close(pen, 0.01 / 4.0);
+        // Vertex 1 6 cm down: inside, but farther than d_tol from its target: no penalty.
+        p[1].z = -0.06;
+        let pen = garnet_loss(points_tensor(&[&p], &device), &b, &topo, &cfg)
+            .unwrap()
+            .values()
+            .unwrap()
+            .pen;
+        close(pen, 0.0);
+    }
+
+    #[test]
+    fn weights_switch_terms_off_but_terms_are_still_reported() {
+        let device = Device::flex();
+        let (b, topo) = batch(&device);
+        let pred = points_tensor(&[&prediction()], &device);
+        let cfg = LossConfig::new()
+            .with_norm(0.0)
+            .with_bend(0.0)
+            .with_pen(0.0);
+        let t = garnet_loss(pred, &b, &topo, &cfg)
+            .unwrap()
+            .values()
+            .unwrap();
+        close(t.total, 0.3125);
+        assert!(t.bend > 0.1 && t.norm > 0.05);
+        assert!(LossConfig::new()
+            .with_vertex(0.0)
+            .with_pen(0.0)
+            .with_norm(0.0)
+            .with_bend(0.0)
+            .validate()
+            .is_err());
+        assert!(LossConfig::new().with_d_tol(-1.0).validate().is_err());
+    }
+
+    /// Central differences of the full loss against its autodiff gradient, for every
+    /// coordinate of a prediction on a 4x4 grid with penetrating, non-penetrating, masked
+    /// and unmasked vertices (all kinks at least a few h away).
+    #[test]
+    fn full_loss_gradient_matches_finite_differences() {
+        let plain = Device::flex();
+        let ad = plain.clone().autodiff();
+        let mesh = geom::TriMesh::grid(4, 4, 0.1);
+        let topo = GarmentTopology::from_mesh(&mesh).unwrap();
+        let target = crate::synthetic::smooth_displacement(&mesh.vertices, 0.3);
+        let n = target.len();
+        // Offsets of 1-3 cm (counted by L_pen) or 8-9 cm (masked out), varied directions.
+        let pred: Vec<Vec3> = target
+            .iter()
+            .enumerate()
+            .map(|(i, g)| {
+                let far = i % 5 == 0;
+                let s = if far {
+                    0.08 + 0.001 * i as f32
+                } else {
+                    0.01 + 0.001 * i as f32
+                };
+                let a = i as f32 * 1.3;
+                *g + s * Vec3::new(
+                    a.cos() * 0.6,
+                    a.sin() * 0.6,
+                    if i % 2 == 0 { -0.53 } else { 0.53 },
+                )
+            })
+            .collect();
+        // Body: a point 4 mm under each target vertex along -y (the grid lies in the y = 0
+        // plane), normals +y; pushed out by 0.2 * 5 cm it ends 6 mm above the target.
+        let body: Vec<Vec3> = target
+            .iter()
+            .map(|g| *g - Vec3::new(0.0, 0.004, 0.0))
+            .collect();
+        let sample = Sample {
+            body: body.clone(),
+            body_normals: vec![Vec3::Y; n],
+            body_edge: 0.05,
+            warped: mesh.vertices.clone(),
+            target: Some(target.clone()),
+        };
+        let spec = InputSpec {
+            sampling: BodySampling {
+                n_body: n,
+                stream: (0..n as u32).collect(),
+                n_centres: 1,
+            },
+            local: None,
+        };
+        let cfg = LossConfig::new();
+        let loss_at = |p: &[Vec3]| -> f64 {
+            let b = Batch::new(&[sample.clone()], &topo, &spec, &plain).unwrap();
+            let tt = topo.to_device(&plain);
+            garnet_loss(points_tensor(&[p], &plain), &b, &tt, &cfg)
+                .unwrap()
+                .values()
+                .unwrap()
+                .total as f64
+        };
+        let b_ad = Batch::new(&[sample.clone()], &topo, &spec, &ad).unwrap();
+        let tt_ad = topo.to_device(&ad);
+        let p_ad = points_tensor(&[&pred], &ad).require_grad();
+        let loss = garnet_loss(p_ad.clone(), &b_ad, &tt_ad, &cfg).unwrap();
+        let grads = loss.total.backward();
+        let g = crate::tensors::read_f32(p_ad.grad(&grads).unwrap()).unwrap();
+        let terms = loss.values().unwrap();
+        assert!(
+            terms.pen > 0.0,
+            "the example must exercise L_pen: {terms:?}"
+        );
+        let h = 2e-4f32;
+        let mut worst = 0.0f64;
+        for i in 0..n {
+            for c in 0..3 {
+                let mut plus = pred.clone();
+                plus[i][c] += h;
+                let mut minus = pred.clone();
+                minus[i][c] -= h;
+                let fd = (loss_at(&plus) - loss_at(&minus)) / (2.0 * h as f64);
+                let ad = g[i * 3 + c] as f64;
+                let err = (fd - ad).abs() / (1e-3 + ad.abs());
+                worst = worst.max(err);
+                assert!(
+                    (fd - ad).abs() <= 2e-4 + 2e-2 * ad.abs(),
+                    "vertex {i} coord {c}: finite difference {fd}, autodiff {ad}"
+                );
+            }
+        }
+        assert!(worst < 0.1, "worst relative error {worst}");
+    }
+}

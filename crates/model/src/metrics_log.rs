@@ -118,3 +118,53 @@ impl MetricsLog {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(epoch: usize, val: bool) -> MetricsRow {
+        MetricsRow {
+            epoch,
+            step: epoch as u64 * 10,
+            lr: 1e-3,
+            seconds: 1.5,
+            train: LossTerms {
+                total: 0.5,
+                vertex: 0.25,
+                pen: 0.0,
+                norm: 0.1,
+                bend: 0.2,
+            },
+            train_samples: 8,
+            validation: val.then_some(Validation {
+                terms: LossTerms::default(),
+                e_dist_cm: 1.25,
+                e_norm_deg: 9.5,
+                samples: 2,
+            }),
+            is_best: val,
+        }
+    }
+
+    #[test]
+    fn appends_rows_and_rewrites_later_epochs() {
+        let dir = tempfile::tempdir().unwrap();
+        let log = MetricsLog::new(dir.path().join("m.csv"));
+        log.append(&row(1, true)).unwrap();
+        log.append(&row(2, false)).unwrap();
+        log.append(&row(3, true)).unwrap();
+        // A run resumed after epoch 1 rewrites epochs 2 and 3.
+        log.append(&row(2, true)).unwrap();
+        let text = std::fs::read_to_string(dir.path().join("m.csv")).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines[0], HEADER);
+        assert_eq!(lines.len(), 3);
+        let cols = HEADER.split(',').count();
+        assert!(lines.iter().all(|l| l.split(',').count() == cols));
+        assert!(lines[1].starts_with("1,10,0.001,1.500,8,0.5,0.25,0,0.1,0.2,2,"));
+        assert!(lines[2].starts_with("2,20,"));
+        assert!(lines[2].ends_with(",1.25,9.5,1"));
+        assert!(row(4, false).to_csv().ends_with(",,,,,,,,0"));
+    }
+}

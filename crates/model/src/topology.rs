@@ -106,3 +106,40 @@ pub struct TopologyTensors {
     /// Bending pairs: two `[P]` index tensors.
     pub bend_pairs: [Tensor<1, Int>; 2],
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ring_rows_hold_self_then_neighbours_then_padding() {
+        let mesh = geom::TriMesh::grid(4, 3, 0.1);
+        let topo = GarmentTopology::from_mesh(&mesh).unwrap();
+        let rings = geom::adjacency::one_ring(12, &mesh.faces).unwrap();
+        let max_degree = (0..12).map(|i| rings.row(i).len()).max().unwrap();
+        assert_eq!(topo.ring_width, max_degree + 1);
+        for i in 0..12 {
+            let row = &topo.ring[i * topo.ring_width..(i + 1) * topo.ring_width];
+            let w = &topo.ring_weight[i * topo.ring_width..(i + 1) * topo.ring_width];
+            let deg = rings.row(i).len();
+            assert_eq!(row[0] as usize, i);
+            assert_eq!(&row[1..=deg], rings.row(i));
+            assert!(row[deg + 1..].iter().all(|&j| j as usize == i));
+            assert!(w[deg + 1..].iter().all(|&v| v == 0.0));
+            let s: f32 = w.iter().sum();
+            assert!((s - 1.0).abs() < 1e-6);
+        }
+        assert_eq!(
+            topo.bend_pairs,
+            geom::adjacency::two_ring_pairs(12, &mesh.faces).unwrap()
+        );
+    }
+
+    #[test]
+    fn refuses_meshes_without_faces_or_with_bad_indices() {
+        let empty = geom::TriMesh::new(vec![glam::Vec3::ZERO; 3], vec![]);
+        assert!(GarmentTopology::from_mesh(&empty).is_err());
+        let bad = geom::TriMesh::new(vec![glam::Vec3::ZERO; 3], vec![[0, 1, 3]]);
+        assert!(GarmentTopology::from_mesh(&bad).is_err());
+    }
+}

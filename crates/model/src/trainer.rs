@@ -73,6 +73,16 @@ pub struct Trainer {
     device: Device,
 }
 
+impl std::fmt::Debug for Trainer {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Trainer")
+            .field("variant", &self.setup.config.variant)
+            .field("state", &self.state)
+            .field("lr", &self.lr)
+            .finish()
+    }
+}
+
 impl Trainer {
     /// A fresh network of `setup.config` on `device` (made an autodiff device), trained with
     /// `loss` and Adam at learning rate `lr` (the paper: 1e-3).
