@@ -327,12 +327,19 @@ fn trainer_writes_checkpoints_and_metrics_and_resumes() {
     assert!(err.to_string().contains("shard 7 unreadable"));
 }
 
-/// GarNet-Local with tiny widths fits one synthetic sample (a smooth ~3 cm drape of a
-/// 120-vertex tube) to a mean vertex error under 1 mm with the full loss and Adam.
+/// GarNet-Local with small widths fits one synthetic sample (a smooth ~3 cm drape of a
+/// 120-vertex tube) to a mean vertex error under 1 mm with the full loss and Adam (learning
+/// rate 1e-3, lowered to 3e-4 and 1e-4 late: near the optimum the L1 bending term dominates
+/// the loss and keeps Adam oscillating at a constant step).
 #[test]
 fn tiny_model_overfits_one_sample_below_one_millimetre() {
     let device = Device::flex();
-    let s = setup(Variant::Local, 120);
+    let mut s = setup(Variant::Local, 120);
+    s.config = s
+        .config
+        .clone()
+        .with_fusion(vec![128, 64, 32])
+        .with_garment_mlp(vec![64, 64]);
     let sample = samples(&s, 1);
     let start_error =
         geom::metrics::e_dist(sample[0].target.as_ref().unwrap(), &sample[0].warped).unwrap();
@@ -350,6 +357,9 @@ fn tiny_model_overfits_one_sample_below_one_millimetre() {
         steps += 1;
         if steps == 1500 {
             trainer.set_lr(3e-4);
+        }
+        if steps == 2500 {
+            trainer.set_lr(1e-4);
         }
     }
     let pred = trainer
