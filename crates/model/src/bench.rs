@@ -14,7 +14,7 @@ use crate::loss::LossConfig;
 use crate::synthetic::{ellipsoid_body, synthetic_sample, tube_garment, BODY_CENTRE};
 use crate::trainer::Trainer;
 
-/// Wall times of repeated runs, milliseconds.
+/// Wall times of repeated runs, milliseconds, and the process CPU time they used.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Timing {
     /// Median.
@@ -25,6 +25,23 @@ pub struct Timing {
     pub max_ms: f64,
     /// Timed runs (after one untimed warm-up).
     pub runs: usize,
+    /// Mean CPU time of the process (all threads) per timed run, milliseconds (Linux only,
+    /// 10 ms clock resolution over all runs). On a machine shared with other work, wall time
+    /// grows with the load while CPU time stays near the work done: `cpu_ms / wall` shows how
+    /// many cores the run really had.
+    pub cpu_ms: Option<f64>,
+}
+
+/// CPU time (user + system, all threads) of this process so far, milliseconds; `None` where
+/// `/proc/self/stat` is not available.
+pub fn process_cpu_ms() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (which is in parentheses and may hold spaces).
+    let rest = stat.rsplit(')').next()?;
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
+    // USER_HZ is 100 on every Linux platform Rust supports.
+    Some(ticks * 10.0)
 }
 
 impl Timing {
@@ -32,11 +49,16 @@ impl Timing {
     pub fn measure<F: FnMut() -> Result<()>>(runs: usize, mut f: F) -> Result<Timing> {
         f()?;
         let mut ms = Vec::with_capacity(runs.max(1));
+        let cpu0 = process_cpu_ms();
         for _ in 0..runs.max(1) {
             let t = Instant::now();
             f()?;
             ms.push(t.elapsed().as_secs_f64() * 1e3);
         }
+        let cpu_ms = match (cpu0, process_cpu_ms()) {
+            (Some(a), Some(b)) => Some((b - a) / ms.len() as f64),
+            _ => None,
+        };
         ms.sort_by(|a, b| a.total_cmp(b));
         let n = ms.len();
         let median = if n % 2 == 1 {
@@ -49,6 +71,7 @@ impl Timing {
             min_ms: ms[0],
             max_ms: ms[n - 1],
             runs: n,
+            cpu_ms,
         })
     }
 }

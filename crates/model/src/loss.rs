@@ -80,8 +80,13 @@ impl LossTerms {
         }
     }
 
+}
+
+impl std::ops::Add for LossTerms {
+    type Output = LossTerms;
+
     /// Term-by-term sum.
-    pub fn add(self, o: LossTerms) -> LossTerms {
+    fn add(self, o: LossTerms) -> LossTerms {
         LossTerms {
             total: self.total + o.total,
             vertex: self.vertex + o.vertex,
@@ -485,7 +490,7 @@ mod tests {
         };
         let cfg = LossConfig::new();
         let loss_at = |p: &[Vec3]| -> f64 {
-            let b = Batch::new(&[sample.clone()], &topo, &spec, &plain).unwrap();
+            let b = Batch::new(std::slice::from_ref(&sample), &topo, &spec, &plain).unwrap();
             let tt = topo.to_device(&plain);
             garnet_loss(points_tensor(&[p], &plain), &b, &tt, &cfg)
                 .unwrap()
@@ -493,7 +498,7 @@ mod tests {
                 .unwrap()
                 .total as f64
         };
-        let b_ad = Batch::new(&[sample.clone()], &topo, &spec, &ad).unwrap();
+        let b_ad = Batch::new(std::slice::from_ref(&sample), &topo, &spec, &ad).unwrap();
         let tt_ad = topo.to_device(&ad);
         let p_ad = points_tensor(&[&pred], &ad).require_grad();
         let loss = garnet_loss(p_ad.clone(), &b_ad, &tt_ad, &cfg).unwrap();

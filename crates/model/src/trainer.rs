@@ -227,7 +227,7 @@ impl Trainer {
                 continue;
             }
             let terms = self.step(&samples)?;
-            sum = sum.add(terms.scaled(samples.len() as f32));
+            sum = sum + terms.scaled(samples.len() as f32);
             count += samples.len();
         }
         Ok((sum.scaled(1.0 / count.max(1) as f32), count))
@@ -257,7 +257,7 @@ impl Trainer {
                 &self.loss,
             )?;
             let w = samples.len();
-            sum = sum.add(ev.terms.scaled(w as f32));
+            sum = sum + ev.terms.scaled(w as f32);
             dist += ev.e_dist_cm as f64 * w as f64;
             norm += ev.e_norm_deg as f64 * w as f64;
             count += w;
