@@ -98,13 +98,15 @@ impl LocalPool {
         // Max over the k nearest kept points, one [B*N, L] gather per neighbour rank (no
         // [B*N*k, L] intermediate).
         let table = local.reshape([1, b * s, l]);
-        let mut cols = idx.knn.iter();
-        let first = cols.next().expect("knn_k >= 1");
-        let mut acc = table.clone().select(1, first.clone());
-        for col in cols {
-            acc = acc.max_pair(table.clone().select(1, col.clone()));
+        let gathered = idx
+            .knn
+            .iter()
+            .map(|col| table.clone().select(1, col.clone()));
+        match gathered.reduce(|acc, t| acc.max_pair(t)) {
+            Some(acc) => acc.reshape([b, n, l]),
+            // No neighbour (knn_k = 0, refused by GarNet::translations): no local feature.
+            None => Tensor::zeros([b, n, l], &table.device()),
         }
-        acc.reshape([b, n, l])
     }
 }
 

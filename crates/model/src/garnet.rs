@@ -109,7 +109,12 @@ impl GarNet {
             let idx = local.ok_or_else(|| {
                 ModelError::InvalidInput("GarNet-Local needs the batch's local tables".into())
             })?;
-            if idx.n_garment != n || idx.pool.dims()[0] != b * idx.n_centres * idx.pool_k {
+            if idx.n_garment != n
+                || idx.pool.dims()[0] != b * idx.n_centres * idx.pool_k
+                || idx.knn_k == 0
+                || idx.knn.len() != idx.knn_k
+                || idx.knn.iter().any(|c| c.dims()[0] != b * n)
+            {
                 return Err(ModelError::InvalidInput(format!(
                     "local tables are for {} garment vertices and another batch size",
                     idx.n_garment

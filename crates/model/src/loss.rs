@@ -79,7 +79,6 @@ impl LossTerms {
             bend: self.bend * w,
         }
     }
-
 }
 
 impl std::ops::Add for LossTerms {
