@@ -35,8 +35,10 @@ impl std::fmt::Debug for Draper {
 
 impl Draper {
     /// Wraps `model` with its `setup`, on `device` (the model is moved there, without
-    /// autodiff). Fails when the model and the setup disagree.
+    /// autodiff). Fails when the model and the setup disagree. Tunes the allocator (see
+    /// [`crate::alloc`]).
     pub fn new(model: GarNet, setup: ModelSetup, device: &Device) -> Result<Draper> {
+        crate::alloc::tune_allocator();
         let device = device.clone().inner();
         if model.variant() != setup.config.variant {
             return Err(ModelError::InvalidInput(format!(

@@ -12,9 +12,36 @@ pub fn lrelu<const D: usize>(x: Tensor<D>) -> Tensor<D> {
     leaky_relu(x, LEAKY_SLOPE)
 }
 
-/// Max over the points of `x` `[B,P,C]`: `[B,C]`.
+/// Max over the points of `x` `[B,P,C]`: `[B,C]`, per sample with [`max_rows`].
 pub fn max_points(x: Tensor<3>) -> Tensor<2> {
-    x.max_dim(1).squeeze_dim(1)
+    let [b, p, c] = x.dims();
+    let per_sample: Vec<Tensor<2>> = (0..b)
+        .map(|i| max_rows(x.clone().narrow(0, i, 1).reshape([p, c])))
+        .collect();
+    if b == 1 {
+        per_sample.into_iter().next().expect("one sample")
+    } else {
+        Tensor::cat(per_sample, 0)
+    }
+}
+
+/// Max over the rows of `x` `[P,C]`: `[1,C]`, as a halving tree of element-wise maxima (the
+/// first `ceil(len/2)` rows against the last `ceil(len/2)`, which overlap by one row when
+/// `len` is odd, harmless for a maximum) over contiguous row blocks. On flex, `max_dim(0)`
+/// costs ~3 ns per element (10 ms for the 6690 x 512 body features) against ~0.4 ns here;
+/// gradients flow through `max_pair` to exactly one of each compared pair, as through
+/// `max_dim`.
+pub fn max_rows(x: Tensor<2>) -> Tensor<2> {
+    let mut x = x;
+    let mut len = x.dims()[0];
+    while len > 1 {
+        let half = len.div_ceil(2);
+        let a = x.clone().narrow(0, 0, half);
+        let b = x.narrow(0, len - half, half);
+        x = a.max_pair(b);
+        len = half;
+    }
+    x
 }
 
 /// A shared per-point MLP (1x1 convolutions): each layer is a fully connected layer applied to
@@ -91,5 +118,33 @@ impl CondLinear {
     /// (no activation).
     pub fn forward(&self, x: Tensor<3>, bias: Tensor<3>) -> Tensor<3> {
         self.point.forward(x) + bias
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tensors::read_f32;
+
+    #[test]
+    fn max_points_equals_max_dim_with_the_same_gradient() {
+        let device = Device::flex().autodiff();
+        for (b, p, c) in [(1, 1, 3), (2, 7, 5), (3, 64, 4), (1, 1001, 2)] {
+            let x = Tensor::<3>::random([b, p, c], burn::tensor::Distribution::Default, &device)
+                .require_grad();
+            let ours = max_points(x.clone());
+            let theirs: Tensor<2> = x.clone().max_dim(1).reshape([b, c]);
+            assert_eq!(
+                read_f32(ours.clone()).unwrap(),
+                read_f32(theirs.clone()).unwrap()
+            );
+            let g1 = x.grad(&(ours.sum() * 2.0).backward()).unwrap();
+            let g2 = x.grad(&(theirs.sum() * 2.0).backward()).unwrap();
+            assert_eq!(
+                read_f32(g1).unwrap(),
+                read_f32(g2).unwrap(),
+                "[{b},{p},{c}]"
+            );
+        }
     }
 }

@@ -32,6 +32,7 @@
 
 #![warn(missing_docs)]
 
+pub mod alloc;
 pub mod batch;
 pub mod bench;
 pub mod body_stream;
@@ -55,6 +56,7 @@ pub mod topology;
 pub mod train;
 pub mod trainer;
 
+pub use alloc::tune_allocator;
 pub use batch::{Batch, BodyTopology, InputSpec, Sample};
 pub use checkpoint::{load_checkpoint, save_checkpoint, Checkpoint, ModelSetup, TrainState};
 pub use config::{GarNetConfig, Variant};

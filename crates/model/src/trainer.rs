@@ -58,7 +58,7 @@ pub struct EpochReport {
 }
 
 /// Trains one network: holds it (on an autodiff device), its Adam optimiser, its setup and
-/// progress.
+/// progress. Making one tunes the allocator (see [`crate::alloc`]).
 pub struct Trainer {
     model: GarNet,
     optim: ModuleOptimizer,
@@ -124,6 +124,7 @@ impl Trainer {
         lr: f64,
         device: Device,
     ) -> Result<Trainer> {
+        crate::alloc::tune_allocator();
         loss.validate()?;
         if !(lr.is_finite() && lr > 0.0) {
             return Err(ModelError::InvalidInput(format!(
