@@ -67,8 +67,9 @@ impl FeaStConv {
         let m = q.dims()[3];
         // Aggregate per head: a_im = sum_j q_ijm x_j, as [d_in,K] x [K,M] per vertex (this
         // orientation runs ~2.5x faster on flex than [M,K] x [K,d_in]).
-        let x_j = x.select(1, ring.clone()).reshape([b, n, k, d_in]);
-        let agg = x_j.swap_dims(2, 3).matmul(q); // [B,N,d_in,M]
+        let x_j = x.select(1, ring.clone()).reshape([b * n, k, d_in]);
+        let q = q.reshape([b * n, k, m]);
+        let agg = x_j.swap_dims(1, 2).matmul(q); // [B*N,d_in,M]
         self.w.forward(agg.reshape([b, n, d_in * m]))
     }
 
