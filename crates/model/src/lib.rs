@@ -5,8 +5,9 @@
 //! always compiled in; `cuda` and `wgpu` behind the cargo features of the same names).
 //! Training uses `device.autodiff()`; inference a plain device.
 //!
-//! Units: metres. Shapes: `B` samples, `V` body vertices, `N` garment vertices, `F` garment
-//! faces, `K` neighbourhood width; point tensors are `[B,V,3]` / `[B,N,3]`.
+//! Units: metres. Shapes: `B` samples, `V` body vertices (13380), `P` body points the body
+//! stream sees (a fixed subset, 6690 by default), `N` garment vertices, `F` garment faces, `K`
+//! neighbourhood width; point tensors are `[B,V,3]`, `[B,P,3]`, `[B,N,3]`.
 //!
 //! The flow, as a CLI uses it:
 //!
