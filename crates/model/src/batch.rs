@@ -1,0 +1,258 @@
+//! Inputs: one training or inference sample as plain [`glam::Vec3`] lists ([`Sample`]), and a
+//! batch of them as tensors ([`Batch`]).
+
+use std::sync::Arc;
+
+use burn::prelude::*;
+use glam::Vec3;
+
+use crate::error::{check_count, check_finite, ModelError, Result};
+use crate::local::{BodySampling, LocalIndices};
+use crate::tensors::{points_tensor, vec_tensor};
+use crate::topology::GarmentTopology;
+
+/// The body mesh connectivity shared by the samples of a dataset (all bodies have one
+/// topology): faces and unique edges, for the body normals and mean edge length that the
+/// penetration loss needs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BodyTopology {
+    /// Number of body vertices V.
+    pub n_vertices: usize,
+    /// `[F]` body triangles, counter-clockwise seen from outside.
+    pub faces: Vec<[u32; 3]>,
+    /// `[E]` unique edges.
+    pub edges: Vec<[u32; 2]>,
+}
+
+impl BodyTopology {
+    /// From the body's vertex count and faces; fails on an out-of-range face index.
+    pub fn new(n_vertices: usize, faces: Vec<[u32; 3]>) -> Result<Self> {
+        geom::adjacency::check_indices(n_vertices, &faces)?;
+        let edges = geom::adjacency::edges(&faces);
+        Ok(BodyTopology {
+            n_vertices,
+            faces,
+            edges,
+        })
+    }
+
+    /// Mean edge length (metres) of the body with vertices `body` `[V]`.
+    pub fn mean_edge_length(&self, body: &[Vec3]) -> f32 {
+        if self.edges.is_empty() {
+            return 0.0;
+        }
+        let sum: f64 = self
+            .edges
+            .iter()
+            .map(|&[a, b]| body[a as usize].distance(body[b as usize]) as f64)
+            .sum();
+        (sum / self.edges.len() as f64) as f32
+    }
+}
+
+/// One sample, in metres.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sample {
+    /// Body vertices `[V]`.
+    pub body: Vec<Vec3>,
+    /// Unit outward body vertex normals `[V]` (used by the penetration loss only).
+    pub body_normals: Vec<Vec3>,
+    /// Mean body edge length (used by the penetration loss only).
+    pub body_edge: f32,
+    /// The DQS-warped garment M `[N]` (the network input).
+    pub warped: Vec<Vec3>,
+    /// The simulated garment G `[N]` (the target), absent at inference.
+    pub target: Option<Vec<Vec3>>,
+}
+
+impl Sample {
+    /// A sample from a posed body `[V]` with the dataset's body topology, the warped garment
+    /// M `[N]` and optionally the simulated garment G `[N]`. Computes the body normals and mean
+    /// edge length. Fails on mismatched counts or non-finite coordinates.
+    pub fn new(
+        body: Vec<Vec3>,
+        body_topology: &BodyTopology,
+        warped: Vec<Vec3>,
+        target: Option<Vec<Vec3>>,
+    ) -> Result<Sample> {
+        check_count("body vertices", body_topology.n_vertices, body.len())?;
+        check_finite("body vertices", &body)?;
+        check_finite("warped garment M", &warped)?;
+        if let Some(t) = &target {
+            check_count("target garment G", warped.len(), t.len())?;
+            check_finite("target garment G", t)?;
+        }
+        let body_normals = geom::normals::vertex_normals(&body, &body_topology.faces);
+        let body_edge = body_topology.mean_edge_length(&body);
+        Ok(Sample {
+            body,
+            body_normals,
+            body_edge,
+            warped,
+            target,
+        })
+    }
+}
+
+/// How samples become network inputs: the body points the stream sees and, for
+/// GarNet-Local, the neighbour counts of its tables. Made by
+/// [`crate::checkpoint::ModelSetup::input_spec`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct InputSpec {
+    /// The body subsampling (stream points and GarNet-Local's kept points).
+    pub sampling: BodySampling,
+    /// GarNet-Local: (stream points averaged per kept point (16), kept points max-pooled per
+    /// garment vertex (15)); `None` for the other variants.
+    pub local: Option<(usize, usize)>,
+}
+
+impl InputSpec {
+    /// The network inputs of B samples: stream points `[B][P]` of `bodies` `[B][V]`, and the
+    /// local tables of them and `warped` `[B][N]` when the spec has them.
+    pub fn inputs(
+        &self,
+        bodies: &[&[Vec3]],
+        warped: &[&[Vec3]],
+        device: &Device,
+    ) -> Result<(Tensor<3>, Option<LocalIndices>)> {
+        let streams = bodies
+            .iter()
+            .map(|b| self.sampling.stream_points(b))
+            .collect::<Result<Vec<_>>>()?;
+        let refs: Vec<&[Vec3]> = streams.iter().map(Vec::as_slice).collect();
+        let local = match self.local {
+            Some((pool_k, knn_k)) => Some(LocalIndices::build(
+                &self.sampling,
+                pool_k,
+                knn_k,
+                &refs,
+                warped,
+                device,
+            )?),
+            None => None,
+        };
+        Ok((points_tensor(&refs, device), local))
+    }
+}
+
+/// A batch of B samples as tensors on one device, sharing one garment topology.
+#[derive(Clone)]
+pub struct Batch {
+    /// Number of samples B.
+    pub size: usize,
+    /// Body vertices per sample V.
+    pub n_body: usize,
+    /// Garment vertices per sample N.
+    pub n_garment: usize,
+    /// The body points the body stream sees `[B,P,3]`, metres.
+    pub body_stream: Tensor<3>,
+    /// Body vertices `[B,V,3]`, metres (the penetration loss).
+    pub body: Tensor<3>,
+    /// Unit body vertex normals `[B,V,3]`.
+    pub body_normals: Tensor<3>,
+    /// Mean body edge length per sample `[B]`, metres.
+    pub body_edge: Tensor<1>,
+    /// Warped garment M `[B,N,3]`, metres.
+    pub warped: Tensor<3>,
+    /// Target garment G `[B,N,3]`, metres (present when every sample has one).
+    pub target: Option<Tensor<3>>,
+    /// GarNet-Local's neighbour tables.
+    pub local: Option<LocalIndices>,
+    /// Per-sample k-d trees over the body vertices (the penetration loss's nearest-vertex
+    /// search), built with the batch when it has targets.
+    pub(crate) body_index: Vec<Arc<geom::KnnIndex>>,
+    /// Targets on the CPU `[B][N]` (the penetration mask and the metrics).
+    pub(crate) target_points: Option<Vec<Vec<Vec3>>>,
+}
+
+impl std::fmt::Debug for Batch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Batch")
+            .field("size", &self.size)
+            .field("n_body", &self.n_body)
+            .field("n_garment", &self.n_garment)
+            .field("has_target", &self.target.is_some())
+            .field("has_local", &self.local.is_some())
+            .finish()
+    }
+}
+
+impl Batch {
+    /// Stacks `samples` (body vertex count as `spec`, the garment matching `topology`) into
+    /// tensors on `device`, with GarNet-Local's tables when `spec` has them. Fails on an empty
+    /// slice, mismatched counts or non-finite coordinates.
+    pub fn new(
+        samples: &[Sample],
+        topology: &GarmentTopology,
+        spec: &InputSpec,
+        device: &Device,
+    ) -> Result<Batch> {
+        let first = samples
+            .first()
+            .ok_or_else(|| ModelError::InvalidInput("empty batch".into()))?;
+        let v = spec.sampling.n_body;
+        let n = topology.n_vertices;
+        check_count("body vertices", v, first.body.len())?;
+        let with_target = samples.iter().all(|s| s.target.is_some());
+        for s in samples {
+            check_count("body vertices", v, s.body.len())?;
+            check_count("body normals", v, s.body_normals.len())?;
+            check_count("warped garment M", n, s.warped.len())?;
+            check_finite("body vertices", &s.body)?;
+            check_finite("warped garment M", &s.warped)?;
+            if !s.body_edge.is_finite() {
+                return Err(ModelError::InvalidInput(
+                    "body edge length is not finite".into(),
+                ));
+            }
+            if let Some(t) = &s.target {
+                check_count("target garment G", n, t.len())?;
+                check_finite("target garment G", t)?;
+            }
+        }
+        let bodies: Vec<&[Vec3]> = samples.iter().map(|s| s.body.as_slice()).collect();
+        let normals: Vec<&[Vec3]> = samples.iter().map(|s| s.body_normals.as_slice()).collect();
+        let warped: Vec<&[Vec3]> = samples.iter().map(|s| s.warped.as_slice()).collect();
+        let (body_stream, local) = spec.inputs(&bodies, &warped, device)?;
+        let (target, target_points, body_index) = if with_target {
+            let targets: Vec<&[Vec3]> = samples
+                .iter()
+                .map(|s| s.target.as_deref().unwrap_or(&[]))
+                .collect();
+            let index = bodies
+                .iter()
+                .map(|b| geom::KnnIndex::new(b).map(Arc::new))
+                .collect::<std::result::Result<Vec<_>, _>>()?;
+            (
+                Some(points_tensor(&targets, device)),
+                Some(targets.iter().map(|t| t.to_vec()).collect()),
+                index,
+            )
+        } else {
+            (None, None, Vec::new())
+        };
+        Ok(Batch {
+            size: samples.len(),
+            n_body: v,
+            n_garment: n,
+            body_stream,
+            body: points_tensor(&bodies, device),
+            body_normals: points_tensor(&normals, device),
+            body_edge: vec_tensor(
+                samples.iter().map(|s| s.body_edge).collect(),
+                [samples.len()],
+                device,
+            ),
+            warped: points_tensor(&warped, device),
+            target,
+            local,
+            body_index,
+            target_points,
+        })
+    }
+
+    /// The targets on the CPU (`[B][N]`), when the batch has them.
+    pub fn target_points(&self) -> Option<&[Vec<Vec3>]> {
+        self.target_points.as_deref()
+    }
+}

@@ -1,0 +1,359 @@
+//! Checkpoints: everything a drape needs (config, weights, garment template, body sampling)
+//! and, for resuming training, the optimiser state and the training progress, in one file.
+//!
+//! Format (`.garnet`, format name `garnet-model-1`): one safetensors file with
+//!
+//! | tensor | dtype | shape | holds |
+//! |---|---|---|---|
+//! | `model` | U8 | `[L]` | the network parameters as burn's burnpack bytes (`Module::into_record`) |
+//! | `optimizer` | U8 | `[L2]` | optional: the Adam state as burnpack bytes (`ModuleOptimizer::into_bytes`) |
+//! | `template.vertices` | F32 | `[N,3]` | the garment template mesh, metres |
+//! | `template.faces` | U32 | `[F,3]` | its triangles |
+//! | `body.stream` | U32 | `[P]` | the body vertices the body stream sees, farthest-point order |
+//!
+//! and JSON metadata `format`, `config` ([`GarNetConfig`]), `loss` ([`LossConfig`]),
+//! `state` ([`TrainState`]), `body.n_vertices` (V) and `body.n_centres` (GarNet-Local's kept
+//! points, a prefix of `body.stream`). Parameters
+//! are stored bit for bit, so a reloaded network gives bit-identical outputs. Files are
+//! written to a temporary file and renamed.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use burn::optim::ModuleOptimizer;
+use burn::prelude::*;
+use burn::store::ModuleRecord;
+use burn::tensor::Bytes;
+use glam::Vec3;
+use safetensors::{tensor::TensorView, Dtype, SafeTensors};
+use serde::{Deserialize, Serialize};
+
+use crate::batch::InputSpec;
+use crate::config::GarNetConfig;
+use crate::error::{ModelError, Result};
+use crate::garnet::GarNet;
+use crate::local::BodySampling;
+use crate::loss::LossConfig;
+
+/// The format name in a checkpoint's metadata.
+pub const FORMAT: &str = "garnet-model-1";
+
+/// What a network needs besides its weights: the architecture, the garment template it was
+/// trained for (its vertex count fixes N, its faces the topology) and the body sampling (which
+/// fixes the body vertex count V).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelSetup {
+    /// Architecture.
+    pub config: GarNetConfig,
+    /// Garment template mesh `[N]` vertices (metres) and `[F]` faces.
+    pub template: geom::TriMesh,
+    /// The body points the network sees.
+    pub body_sampling: BodySampling,
+}
+
+impl ModelSetup {
+    /// The setup of `config` for the garment `template`, sampling the body points on
+    /// `reference_body` (`[V]`, metres; any body of the dataset, e.g. the template body).
+    pub fn new(
+        config: GarNetConfig,
+        template: geom::TriMesh,
+        reference_body: &[Vec3],
+    ) -> Result<Self> {
+        config.validate()?;
+        template.validate()?;
+        let body_sampling = BodySampling::farthest_point(
+            reference_body,
+            config.body_subsample,
+            config.body_downsample,
+        )?;
+        Ok(ModelSetup {
+            config,
+            template,
+            body_sampling,
+        })
+    }
+
+    /// How samples become this network's inputs.
+    pub fn input_spec(&self) -> InputSpec {
+        InputSpec {
+            sampling: self.body_sampling.clone(),
+            local: self
+                .config
+                .variant
+                .has_local()
+                .then_some((self.config.pool_neighbours, self.config.local_neighbours)),
+        }
+    }
+
+    /// Fails when the template or the sampling is invalid, or the sampling has fewer kept
+    /// points than GarNet-Local's neighbour count.
+    pub fn validate(&self) -> Result<()> {
+        self.config.validate()?;
+        self.template.validate()?;
+        self.body_sampling.validate()?;
+        if self.config.variant.has_local()
+            && (self.body_sampling.n_centres < self.config.local_neighbours
+                || self.body_sampling.len() < self.config.pool_neighbours)
+        {
+            return Err(ModelError::InvalidInput(format!(
+                "GarNet-Local needs at least {} kept and {} stream body points, the sampling \
+                 has {} and {}",
+                self.config.local_neighbours,
+                self.config.pool_neighbours,
+                self.body_sampling.n_centres,
+                self.body_sampling.len()
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// Training progress stored with a checkpoint.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TrainState {
+    /// Epochs completed.
+    pub epoch: usize,
+    /// Optimiser steps taken.
+    pub step: u64,
+    /// Learning rate of the last step.
+    pub lr: f64,
+    /// Best validation E_dist so far, centimetres (`None` before the first validation).
+    pub best_e_dist_cm: Option<f32>,
+}
+
+/// A checkpoint read from disk; [`Checkpoint::model`] and [`Checkpoint::optimizer`] rebuild
+/// the network and the optimiser.
+pub struct Checkpoint {
+    /// Architecture, template, body sampling.
+    pub setup: ModelSetup,
+    /// Loss weights the network was trained with.
+    pub loss: LossConfig,
+    /// Training progress.
+    pub state: TrainState,
+    model_bytes: Vec<u8>,
+    optimizer_bytes: Option<Vec<u8>>,
+}
+
+impl std::fmt::Debug for Checkpoint {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Checkpoint")
+            .field("setup", &self.setup)
+            .field("state", &self.state)
+            .field("model_bytes", &self.model_bytes.len())
+            .field("has_optimizer", &self.optimizer_bytes.is_some())
+            .finish()
+    }
+}
+
+fn to_le<T: Copy, const W: usize>(values: impl Iterator<Item = T>, f: fn(T) -> [u8; W]) -> Vec<u8> {
+    values.flat_map(f).collect()
+}
+
+fn json<T: Serialize>(value: &T) -> Result<String> {
+    serde_json::to_string(value).map_err(|e| ModelError::InvalidInput(e.to_string()))
+}
+
+/// Writes `model` (any device) with `setup`, `loss`, `state` and optionally the optimiser
+/// state to `path` (atomically: a temporary file, then a rename).
+pub fn save_checkpoint(
+    path: &Path,
+    model: &GarNet,
+    optim: Option<&ModuleOptimizer>,
+    setup: &ModelSetup,
+    loss: &LossConfig,
+    state: &TrainState,
+) -> Result<()> {
+    let bad = |m: String| ModelError::checkpoint(path, m);
+    setup.validate()?;
+    if model.variant() != setup.config.variant {
+        return Err(bad(format!(
+            "network is GarNet-{} but its config says {}",
+            model.variant().name(),
+            setup.config.variant.name()
+        )));
+    }
+    let model_bytes = model
+        .clone()
+        .into_record()
+        .into_bytes()
+        .map_err(|e| bad(e.to_string()))?;
+    let optim_bytes = match optim {
+        Some(o) => Some(o.into_bytes().map_err(|e| bad(e.to_string()))?),
+        None => None,
+    };
+    let t = &setup.template;
+    let mut tensors: Vec<(&str, Dtype, Vec<usize>, Vec<u8>)> = vec![
+        (
+            "model",
+            Dtype::U8,
+            vec![model_bytes.len()],
+            model_bytes.to_vec(),
+        ),
+        (
+            "template.vertices",
+            Dtype::F32,
+            vec![t.vertices.len(), 3],
+            to_le(
+                t.vertices.iter().flat_map(|v| v.to_array()),
+                f32::to_le_bytes,
+            ),
+        ),
+        (
+            "template.faces",
+            Dtype::U32,
+            vec![t.faces.len(), 3],
+            to_le(t.faces.iter().flatten().copied(), u32::to_le_bytes),
+        ),
+    ];
+    let s = &setup.body_sampling;
+    tensors.push((
+        "body.stream",
+        Dtype::U32,
+        vec![s.stream.len()],
+        to_le(s.stream.iter().copied(), u32::to_le_bytes),
+    ));
+    if let Some(o) = &optim_bytes {
+        tensors.push(("optimizer", Dtype::U8, vec![o.len()], o.to_vec()));
+    }
+    let meta: HashMap<String, String> = HashMap::from([
+        ("format".into(), FORMAT.into()),
+        ("config".into(), json(&setup.config)?),
+        ("loss".into(), json(loss)?),
+        ("state".into(), json(state)?),
+        ("body.n_vertices".into(), s.n_body.to_string()),
+        ("body.n_centres".into(), s.n_centres.to_string()),
+    ]);
+    let views = tensors
+        .iter()
+        .map(|(name, d, shape, bytes)| {
+            TensorView::new(*d, shape.clone(), bytes)
+                .map(|v| (*name, v))
+                .map_err(|e| bad(e.to_string()))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let bytes = safetensors::serialize(views, Some(meta)).map_err(|e| bad(e.to_string()))?;
+    geom::io::write_bytes_atomic(path, &bytes)?;
+    Ok(())
+}
+
+/// Reads a checkpoint written by [`save_checkpoint`]; a malformed file is an error naming
+/// the file and the problem.
+pub fn load_checkpoint(path: &Path) -> Result<Checkpoint> {
+    let bad = |m: String| ModelError::checkpoint(path, m);
+    let bytes = std::fs::read(path).map_err(|e| bad(e.to_string()))?;
+    let (_, meta) = SafeTensors::read_metadata(&bytes)
+        .map_err(|e| bad(format!("not a GarNet checkpoint: {e}")))?;
+    let meta = meta.metadata().clone().unwrap_or_default();
+    if meta.get("format").map(String::as_str) != Some(FORMAT) {
+        return Err(bad(format!("not a {FORMAT} file")));
+    }
+    let field = |key: &str| -> Result<&String> {
+        meta.get(key)
+            .ok_or_else(|| bad(format!("missing metadata {key}")))
+    };
+    let config: GarNetConfig =
+        serde_json::from_str(field("config")?).map_err(|e| bad(format!("metadata config: {e}")))?;
+    let loss: LossConfig =
+        serde_json::from_str(field("loss")?).map_err(|e| bad(format!("metadata loss: {e}")))?;
+    let state: TrainState =
+        serde_json::from_str(field("state")?).map_err(|e| bad(format!("metadata state: {e}")))?;
+    let st = SafeTensors::deserialize(&bytes).map_err(|e| bad(e.to_string()))?;
+    let names = st.names();
+    let data = |name: &str, dtype: Dtype| -> Result<&[u8]> {
+        let t = st
+            .tensor(name)
+            .map_err(|_| bad(format!("missing tensor {name}")))?;
+        if t.dtype() != dtype {
+            return Err(bad(format!(
+                "tensor {name} is {:?}, expected {dtype:?}",
+                t.dtype()
+            )));
+        }
+        Ok(t.data())
+    };
+    let f32s: Vec<f32> = data("template.vertices", Dtype::F32)?
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
+    let u32s = |name: &str| -> Result<Vec<u32>> {
+        Ok(data(name, Dtype::U32)?
+            .chunks_exact(4)
+            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect())
+    };
+    let faces = u32s("template.faces")?;
+    if f32s.len() % 3 != 0 || faces.len() % 3 != 0 {
+        return Err(bad("template arrays are not [N,3] / [F,3]".into()));
+    }
+    let template = geom::TriMesh::new(
+        f32s.chunks_exact(3).map(Vec3::from_slice).collect(),
+        faces.chunks_exact(3).map(|f| [f[0], f[1], f[2]]).collect(),
+    );
+    let count = |key: &str| -> Result<usize> {
+        field(key)?
+            .parse()
+            .map_err(|e| bad(format!("metadata {key}: {e}")))
+    };
+    let body_sampling = BodySampling {
+        n_body: count("body.n_vertices")?,
+        n_centres: count("body.n_centres")?,
+        stream: u32s("body.stream")?,
+    };
+    let model_bytes = data("model", Dtype::U8)?.to_vec();
+    let optimizer_bytes = if names.contains(&"optimizer") {
+        Some(data("optimizer", Dtype::U8)?.to_vec())
+    } else {
+        None
+    };
+    let setup = ModelSetup {
+        config,
+        template,
+        body_sampling,
+    };
+    setup.validate().map_err(|e| bad(e.to_string()))?;
+    Ok(Checkpoint {
+        setup,
+        loss,
+        state,
+        model_bytes,
+        optimizer_bytes,
+    })
+}
+
+impl Checkpoint {
+    /// The network with the stored parameters, on `device` (a plain device for inference, an
+    /// autodiff device to train on). Fails when the stored parameters do not fit the config.
+    pub fn model(&self, device: &Device) -> Result<GarNet> {
+        let model = self.setup.config.init(device)?;
+        let record = ModuleRecord::from_bytes(Bytes::from_bytes_vec(self.model_bytes.clone()))
+            .map_err(|e| ModelError::Checkpoint {
+                path: "<model record>".into(),
+                msg: e.to_string(),
+            })?;
+        model
+            .try_load_record(record)
+            .map_err(|e| ModelError::Checkpoint {
+                path: "<model record>".into(),
+                msg: e.to_string(),
+            })
+    }
+
+    /// The stored Adam state applied to a fresh Adam optimiser, when the checkpoint has one.
+    pub fn optimizer(&self) -> Result<Option<ModuleOptimizer>> {
+        match &self.optimizer_bytes {
+            None => Ok(None),
+            Some(b) => crate::train::adam()
+                .from_bytes(Bytes::from_bytes_vec(b.clone()))
+                .map(Some)
+                .map_err(|e| ModelError::Checkpoint {
+                    path: "<optimizer record>".into(),
+                    msg: e.to_string(),
+                }),
+        }
+    }
+
+    /// Whether the checkpoint holds an optimiser state.
+    pub fn has_optimizer(&self) -> bool {
+        self.optimizer_bytes.is_some()
+    }
+}

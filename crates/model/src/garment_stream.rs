@@ -1,0 +1,157 @@
+//! The garment stream (paper Fig. 3 and 4).
+//!
+//! ```text
+//! M [B,N,3] -> STN 3x3 -> MLP (global body feature enters every layer) -> point-wise [B,N,P]
+//!   -> (Global, Local) 6 residual blocks of FeaStNet convolutions, each convolution's input
+//!      concatenated with the vertex positions M -> patch-wise [B,N,C]
+//! [point; patch] -> shared layer -> max over vertices -> global garment feature [B,G]
+//! ```
+
+use burn::nn::Linear;
+use burn::prelude::*;
+
+use crate::config::GarNetConfig;
+use crate::feast::FeaStConv;
+use crate::init::ParamInit;
+use crate::layers::{lrelu, max_points, CondLinear};
+use crate::stn::Stn;
+use crate::topology::TopologyTensors;
+
+/// A residual block of FeaStNet convolutions `C+3 -> C`, each seeing the features
+/// concatenated with the vertex positions M, LeakyReLU between them, the block input added
+/// before the last activation: with one convolution `y = lrelu(x + conv([x; M]))`, with two
+/// `y = lrelu(x + conv2([lrelu(conv1([x; M])); M]))`.
+#[derive(Module, Debug)]
+pub struct ResBlock {
+    /// The convolutions, in order.
+    pub convs: Vec<FeaStConv>,
+}
+
+impl ResBlock {
+    fn new(
+        width: usize,
+        convs: usize,
+        heads: usize,
+        init: &mut ParamInit,
+        device: &Device,
+    ) -> Self {
+        ResBlock {
+            convs: (0..convs)
+                .map(|_| FeaStConv::new(width + 3, width, heads, init, device))
+                .collect(),
+        }
+    }
+
+    /// `x` `[B,N,C]`, `pos` `[B,N,3]` -> `[B,N,C]`.
+    pub fn forward(&self, x: Tensor<3>, pos: Tensor<3>, topo: &TopologyTensors) -> Tensor<3> {
+        let mut h = x.clone();
+        for (i, conv) in self.convs.iter().enumerate() {
+            if i > 0 {
+                h = lrelu(h);
+            }
+            h = conv.forward(
+                Tensor::cat(vec![h, pos.clone()], 2),
+                &topo.ring,
+                &topo.ring_weight,
+            );
+        }
+        lrelu(x + h)
+    }
+}
+
+/// Garment stream.
+#[derive(Module, Debug)]
+pub struct GarmentStream {
+    /// Input transform on M (3x3).
+    pub stn: Stn,
+    /// Point-wise MLP layers, each conditioned on the global body feature.
+    pub mlp: Vec<CondLinear>,
+    /// Layer `P -> C` into the convolutions when the point-wise width P differs from the
+    /// convolution width C (none for Naive or when they match).
+    pub conv_in: Option<Linear>,
+    /// Residual mesh-convolution blocks (empty for GarNet-Naive).
+    pub blocks: Vec<ResBlock>,
+    /// Shared layer before the max pooling to the global garment feature.
+    pub global: Linear,
+}
+
+/// Outputs of the garment stream.
+#[derive(Clone, Debug)]
+pub struct GarmentFeatures {
+    /// Point-wise garment features `[B,N,P]`.
+    pub points: Tensor<3>,
+    /// Patch-wise garment features `[B,N,C]` (none for GarNet-Naive).
+    pub patches: Option<Tensor<3>>,
+    /// Global garment feature `[B,G]`.
+    pub global: Tensor<2>,
+}
+
+impl GarmentStream {
+    pub(crate) fn new(cfg: &GarNetConfig, init: &mut ParamInit, device: &Device) -> Self {
+        let stn = Stn::new(3, &cfg.stn_mlp, &cfg.stn_fc, init, device);
+        let cb = cfg.body_feature_width();
+        let mut mlp = Vec::with_capacity(cfg.garment_mlp.len());
+        let mut d = 3;
+        for &w in &cfg.garment_mlp {
+            mlp.push(CondLinear::new(d, cb, w, init, device));
+            d = w;
+        }
+        let p = d;
+        let (conv_in, blocks, d_global) = if cfg.variant.has_mesh_conv() {
+            let c = cfg.conv_width;
+            let conv_in = (p != c).then(|| init.hidden(p, c, device));
+            let blocks = (0..cfg.conv_blocks)
+                .map(|_| ResBlock::new(c, cfg.convs_per_block, cfg.conv_heads, init, device))
+                .collect();
+            (conv_in, blocks, p + c)
+        } else {
+            (None, Vec::new(), p)
+        };
+        let global = init.hidden(d_global, cfg.garment_global, device);
+        GarmentStream {
+            stn,
+            mlp,
+            conv_in,
+            blocks,
+            global,
+        }
+    }
+
+    /// `warped` M `[B,N,3]` (metres), `body_global` `[B,Cb]` -> point-wise, patch-wise and
+    /// global garment features.
+    pub fn forward(
+        &self,
+        warped: Tensor<3>,
+        body_global: Tensor<2>,
+        topo: &TopologyTensors,
+    ) -> GarmentFeatures {
+        let mut h = self.stn.forward(warped.clone());
+        for layer in &self.mlp {
+            let bias = layer.cond_bias(body_global.clone());
+            h = lrelu(layer.forward(h, bias));
+        }
+        let points = h;
+        let patches = if self.blocks.is_empty() {
+            None
+        } else {
+            let mut c = match &self.conv_in {
+                Some(l) => lrelu(l.forward(points.clone())),
+                None => points.clone(),
+            };
+            for block in &self.blocks {
+                c = block.forward(c, warped.clone(), topo);
+            }
+            Some(c)
+        };
+        let g_in = match &patches {
+            Some(c) => Tensor::cat(vec![points.clone(), c.clone()], 2),
+            None => points.clone(),
+        };
+        let global = max_points(lrelu(self.global.forward(g_in)));
+        GarmentFeatures {
+            points,
+            patches,
+            global,
+        }
+    }
+}

@@ -1,0 +1,150 @@
+//! Small building blocks: shared per-point MLPs, layers conditioned on a per-sample vector,
+//! LeakyReLU and max pooling over points.
+
+use burn::nn::Linear;
+use burn::prelude::*;
+use burn::tensor::activation::leaky_relu;
+
+use crate::init::{ParamInit, LEAKY_SLOPE};
+
+/// LeakyReLU with GarNet's slope 0.1.
+pub fn lrelu<const D: usize>(x: Tensor<D>) -> Tensor<D> {
+    leaky_relu(x, LEAKY_SLOPE)
+}
+
+/// Max over the points of `x` `[B,P,C]`: `[B,C]`, per sample with [`max_rows`].
+pub fn max_points(x: Tensor<3>) -> Tensor<2> {
+    let [b, p, c] = x.dims();
+    let per_sample: Vec<Tensor<2>> = (0..b)
+        .map(|i| max_rows(x.clone().narrow(0, i, 1).reshape([p, c])))
+        .collect();
+    if b == 1 {
+        per_sample.into_iter().next().expect("one sample")
+    } else {
+        Tensor::cat(per_sample, 0)
+    }
+}
+
+/// Max over the rows of `x` `[P,C]`: `[1,C]`, as a halving tree of element-wise maxima (the
+/// first `ceil(len/2)` rows against the last `ceil(len/2)`, which overlap by one row when
+/// `len` is odd, harmless for a maximum) over contiguous row blocks. On flex, `max_dim(0)`
+/// costs ~3 ns per element (10 ms for the 6690 x 512 body features) against ~0.4 ns here;
+/// gradients flow through `max_pair` to exactly one of each compared pair, as through
+/// `max_dim`.
+pub fn max_rows(x: Tensor<2>) -> Tensor<2> {
+    let mut x = x;
+    let mut len = x.dims()[0];
+    while len > 1 {
+        let half = len.div_ceil(2);
+        let a = x.clone().narrow(0, 0, half);
+        let b = x.narrow(0, len - half, half);
+        x = a.max_pair(b);
+        len = half;
+    }
+    x
+}
+
+/// A shared per-point MLP (1x1 convolutions): each layer is a fully connected layer applied to
+/// every point, then LeakyReLU(0.1).
+#[derive(Module, Debug)]
+pub struct PointMlp {
+    /// The layers, input to output.
+    pub layers: Vec<Linear>,
+}
+
+impl PointMlp {
+    /// An MLP `d_in -> widths[0] -> ... -> widths[last]`.
+    pub(crate) fn new(
+        d_in: usize,
+        widths: &[usize],
+        init: &mut ParamInit,
+        device: &Device,
+    ) -> Self {
+        let mut layers = Vec::with_capacity(widths.len());
+        let mut d = d_in;
+        for &w in widths {
+            layers.push(init.hidden(d, w, device));
+            d = w;
+        }
+        PointMlp { layers }
+    }
+
+    /// `x` `[B,P,d_in]` -> `[B,P,widths[last]]`.
+    pub fn forward<const D: usize>(&self, x: Tensor<D>) -> Tensor<D> {
+        self.layers
+            .iter()
+            .fold(x, |x, layer| lrelu(layer.forward(x)))
+    }
+
+    /// Output width.
+    pub fn d_out(&self) -> usize {
+        self.layers
+            .last()
+            .map(|l| l.weight.val().dims()[1])
+            .unwrap_or(0)
+    }
+}
+
+/// A per-point layer whose input is the point's features concatenated with a per-sample
+/// vector `c` (the same for every point of a sample). `W [x; c] + b = W_x x + (W_c c + b)`, so
+/// the per-sample part is computed once per sample and added as a bias instead of being
+/// concatenated to every point.
+#[derive(Module, Debug)]
+pub struct CondLinear {
+    /// `W_x` and `b`: `[d_point, d_out]`, `[d_out]`.
+    pub point: Linear,
+    /// `W_c`: `[d_cond, d_out]`, no bias.
+    pub cond: Linear,
+}
+
+impl CondLinear {
+    pub(crate) fn new(
+        d_point: usize,
+        d_cond: usize,
+        d_out: usize,
+        init: &mut ParamInit,
+        device: &Device,
+    ) -> Self {
+        let (point, cond) = init.hidden_split(d_point, d_cond, d_out, device);
+        CondLinear { point, cond }
+    }
+
+    /// The per-sample bias `W_c c`: `c` `[B,d_cond]` -> `[B,1,d_out]`.
+    pub fn cond_bias(&self, c: Tensor<2>) -> Tensor<3> {
+        self.cond.forward(c).unsqueeze_dim(1)
+    }
+
+    /// `W_x x + b + bias`: `x` `[B,P,d_point]`, `bias` `[B,1,d_out]` -> `[B,P,d_out]`
+    /// (no activation).
+    pub fn forward(&self, x: Tensor<3>, bias: Tensor<3>) -> Tensor<3> {
+        self.point.forward(x) + bias
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tensors::read_f32;
+
+    #[test]
+    fn max_points_equals_max_dim_with_the_same_gradient() {
+        let device = Device::flex().autodiff();
+        for (b, p, c) in [(1, 1, 3), (2, 7, 5), (3, 64, 4), (1, 1001, 2)] {
+            let x = Tensor::<3>::random([b, p, c], burn::tensor::Distribution::Default, &device)
+                .require_grad();
+            let ours = max_points(x.clone());
+            let theirs: Tensor<2> = x.clone().max_dim(1).reshape([b, c]);
+            assert_eq!(
+                read_f32(ours.clone()).unwrap(),
+                read_f32(theirs.clone()).unwrap()
+            );
+            let g1 = x.grad(&(ours.sum() * 2.0).backward()).unwrap();
+            let g2 = x.grad(&(theirs.sum() * 2.0).backward()).unwrap();
+            assert_eq!(
+                read_f32(g1).unwrap(),
+                read_f32(g2).unwrap(),
+                "[{b},{p},{c}]"
+            );
+        }
+    }
+}

@@ -1,0 +1,396 @@
+//! The training loop: epochs over an iterator of sample batches, validation after each
+//! epoch, `last.garnet` and `best.garnet` checkpoints (best = lowest validation E_dist) and a
+//! `metrics.csv` log; resumable from any checkpoint with its optimiser state.
+
+use std::fmt::Display;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use burn::optim::ModuleOptimizer;
+use burn::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::batch::{Batch, InputSpec, Sample};
+use crate::checkpoint::{load_checkpoint, save_checkpoint, ModelSetup, TrainState};
+use crate::drape::Draper;
+use crate::error::{ModelError, Result};
+use crate::garnet::GarNet;
+use crate::loss::{LossConfig, LossTerms};
+use crate::metrics_log::{MetricsLog, MetricsRow};
+use crate::topology::{GarmentTopology, TopologyTensors};
+use crate::train::{adam, evaluate_batch, train_step};
+
+/// File name of the checkpoint written after every epoch.
+pub const LAST_CHECKPOINT: &str = "last.garnet";
+/// File name of the checkpoint of the epoch with the lowest validation E_dist.
+pub const BEST_CHECKPOINT: &str = "best.garnet";
+/// File name of the per-epoch metrics log.
+pub const METRICS_LOG: &str = "metrics.csv";
+
+/// Validation results averaged over samples.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Validation {
+    /// Loss terms.
+    pub terms: LossTerms,
+    /// Mean vertex distance, centimetres.
+    pub e_dist_cm: f32,
+    /// Mean face-normal angle, degrees.
+    pub e_norm_deg: f32,
+    /// Number of samples.
+    pub samples: usize,
+}
+
+/// What one epoch did.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EpochReport {
+    /// The epoch number (1-based: epochs completed after it).
+    pub epoch: usize,
+    /// Training loss terms averaged over the epoch's samples.
+    pub train: LossTerms,
+    /// Training samples seen.
+    pub train_samples: usize,
+    /// Validation results (when a validation set was given).
+    pub validation: Option<Validation>,
+    /// Whether this epoch gave a new best checkpoint.
+    pub is_best: bool,
+    /// Wall time of the epoch including validation and checkpoints, seconds.
+    pub seconds: f64,
+}
+
+/// Trains one network: holds it (on an autodiff device), its Adam optimiser, its setup and
+/// progress. Making one tunes the allocator (see [`crate::alloc`]).
+pub struct Trainer {
+    model: GarNet,
+    optim: ModuleOptimizer,
+    setup: ModelSetup,
+    topology: GarmentTopology,
+    topo: TopologyTensors,
+    topo_valid: TopologyTensors,
+    spec: InputSpec,
+    loss: LossConfig,
+    lr: f64,
+    state: TrainState,
+    device: Device,
+}
+
+impl std::fmt::Debug for Trainer {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Trainer")
+            .field("variant", &self.setup.config.variant)
+            .field("state", &self.state)
+            .field("lr", &self.lr)
+            .finish()
+    }
+}
+
+impl Trainer {
+    /// A fresh network of `setup.config` on `device` (made an autodiff device), trained with
+    /// `loss` and Adam at learning rate `lr` (the paper: 1e-3).
+    pub fn new(setup: ModelSetup, loss: LossConfig, lr: f64, device: &Device) -> Result<Trainer> {
+        let device = device.clone().autodiff();
+        let model = setup.config.init(&device)?;
+        Trainer::with_parts(
+            model,
+            adam(),
+            setup,
+            loss,
+            TrainState::default(),
+            lr,
+            device,
+        )
+    }
+
+    /// Resumes from a checkpoint: network, optimiser state (a fresh Adam when the checkpoint
+    /// has none), loss config and progress; `lr` overrides the stored learning rate when given.
+    pub fn resume(path: &Path, lr: Option<f64>, device: &Device) -> Result<Trainer> {
+        let ck = load_checkpoint(path)?;
+        let device = device.clone().autodiff();
+        let model = ck.model(&device)?;
+        let optim = ck.optimizer()?.unwrap_or_else(adam);
+        let lr = lr.unwrap_or(if ck.state.lr > 0.0 {
+            ck.state.lr
+        } else {
+            crate::train::PAPER_LEARNING_RATE
+        });
+        Trainer::with_parts(model, optim, ck.setup, ck.loss, ck.state, lr, device)
+    }
+
+    fn with_parts(
+        model: GarNet,
+        optim: ModuleOptimizer,
+        setup: ModelSetup,
+        loss: LossConfig,
+        state: TrainState,
+        lr: f64,
+        device: Device,
+    ) -> Result<Trainer> {
+        crate::alloc::tune_allocator();
+        loss.validate()?;
+        if !(lr.is_finite() && lr > 0.0) {
+            return Err(ModelError::InvalidInput(format!(
+                "learning rate must be > 0, got {lr}"
+            )));
+        }
+        let topology = GarmentTopology::from_mesh(&setup.template)?;
+        let topo = topology.to_device(&device);
+        let topo_valid = topology.to_device(&device.clone().inner());
+        setup.validate()?;
+        let spec = setup.input_spec();
+        Ok(Trainer {
+            model,
+            optim,
+            setup,
+            topology,
+            topo,
+            topo_valid,
+            spec,
+            loss,
+            lr,
+            state,
+            device,
+        })
+    }
+
+    /// The network (on the autodiff device).
+    pub fn model(&self) -> &GarNet {
+        &self.model
+    }
+
+    /// Setup: config, template, body sampling.
+    pub fn setup(&self) -> &ModelSetup {
+        &self.setup
+    }
+
+    /// Training progress.
+    pub fn state(&self) -> &TrainState {
+        &self.state
+    }
+
+    /// The learning rate.
+    pub fn lr(&self) -> f64 {
+        self.lr
+    }
+
+    /// Sets the learning rate for the next steps.
+    pub fn set_lr(&mut self, lr: f64) {
+        self.lr = lr;
+    }
+
+    /// The loss configuration.
+    pub fn loss_config(&self) -> &LossConfig {
+        &self.loss
+    }
+
+    /// `samples` as a training batch on the autodiff device.
+    pub fn train_batch(&self, samples: &[Sample]) -> Result<Batch> {
+        Batch::new(samples, &self.topology, &self.spec, &self.device)
+    }
+
+    /// `samples` as a validation batch on the plain device.
+    pub fn valid_batch(&self, samples: &[Sample]) -> Result<Batch> {
+        Batch::new(
+            samples,
+            &self.topology,
+            &self.spec,
+            &self.device.clone().inner(),
+        )
+    }
+
+    /// One optimiser step on `samples` (which need targets); returns the loss terms.
+    pub fn step(&mut self, samples: &[Sample]) -> Result<LossTerms> {
+        let batch = self.train_batch(samples)?;
+        let terms = train_step(
+            &mut self.model,
+            &mut self.optim,
+            &batch,
+            &self.topo,
+            &self.loss,
+            self.lr,
+        )?;
+        self.state.step += 1;
+        self.state.lr = self.lr;
+        Ok(terms)
+    }
+
+    /// One pass over `batches` (each a `Vec<Sample>` or the data source's error), one step
+    /// per batch; returns the loss terms averaged over samples and the sample count. Does not
+    /// advance the epoch counter (see [`Trainer::run_epoch`]).
+    pub fn train_epoch<I, E>(&mut self, batches: I) -> Result<(LossTerms, usize)>
+    where
+        I: IntoIterator<Item = std::result::Result<Vec<Sample>, E>>,
+        E: Display,
+    {
+        let mut sum = LossTerms::default();
+        let mut count = 0usize;
+        for batch in batches {
+            let samples = batch.map_err(|e| ModelError::Data(e.to_string()))?;
+            if samples.is_empty() {
+                continue;
+            }
+            let terms = self.step(&samples)?;
+            sum = sum + terms.scaled(samples.len() as f32);
+            count += samples.len();
+        }
+        Ok((sum.scaled(1.0 / count.max(1) as f32), count))
+    }
+
+    /// Evaluates the network (without autodiff) on `batches`; averages over samples.
+    pub fn validate<I, E>(&self, batches: I) -> Result<Validation>
+    where
+        I: IntoIterator<Item = std::result::Result<Vec<Sample>, E>>,
+        E: Display,
+    {
+        let model = self.model.valid();
+        let mut sum = LossTerms::default();
+        let (mut dist, mut norm) = (0.0f64, 0.0f64);
+        let mut count = 0usize;
+        for batch in batches {
+            let samples = batch.map_err(|e| ModelError::Data(e.to_string()))?;
+            if samples.is_empty() {
+                continue;
+            }
+            let b = self.valid_batch(&samples)?;
+            let ev = evaluate_batch(
+                &model,
+                &b,
+                &self.topo_valid,
+                &self.setup.template.faces,
+                &self.loss,
+            )?;
+            let w = samples.len();
+            sum = sum + ev.terms.scaled(w as f32);
+            dist += ev.e_dist_cm as f64 * w as f64;
+            norm += ev.e_norm_deg as f64 * w as f64;
+            count += w;
+        }
+        let c = count.max(1) as f64;
+        Ok(Validation {
+            terms: sum.scaled(1.0 / c as f32),
+            e_dist_cm: (dist / c) as f32,
+            e_norm_deg: (norm / c) as f32,
+            samples: count,
+        })
+    }
+
+    /// Writes a checkpoint of the current network, optimiser state and progress to `path`.
+    pub fn save(&self, path: &Path) -> Result<()> {
+        save_checkpoint(
+            path,
+            &self.model,
+            Some(&self.optim),
+            &self.setup,
+            &self.loss,
+            &self.state,
+        )
+    }
+
+    /// A [`Draper`] of the current network on the plain device.
+    pub fn draper(&self) -> Result<Draper> {
+        Draper::new(
+            self.model.clone(),
+            self.setup.clone(),
+            &self.device.clone().inner(),
+        )
+    }
+
+    /// One epoch: trains on `train`, validates on `valid` (when given), advances the epoch
+    /// counter, writes `out_dir/last.garnet`, `out_dir/best.garnet` when validation E_dist
+    /// improved (or, without validation, every epoch), and appends a row to
+    /// `out_dir/metrics.csv`.
+    pub fn run_epoch<I, J, E>(
+        &mut self,
+        train: I,
+        valid: Option<J>,
+        out_dir: &Path,
+    ) -> Result<EpochReport>
+    where
+        I: IntoIterator<Item = std::result::Result<Vec<Sample>, E>>,
+        J: IntoIterator<Item = std::result::Result<Vec<Sample>, E>>,
+        E: Display,
+    {
+        let start = Instant::now();
+        std::fs::create_dir_all(out_dir).map_err(|e| ModelError::Io {
+            path: out_dir.to_path_buf(),
+            source: e,
+        })?;
+        let (train_terms, train_samples) = self.train_epoch(train)?;
+        let validation = match valid {
+            Some(v) => Some(self.validate(v)?),
+            None => None,
+        };
+        self.state.epoch += 1;
+        let is_best = match &validation {
+            Some(v) if v.samples > 0 => {
+                let better = self.state.best_e_dist_cm.is_none_or(|b| v.e_dist_cm < b);
+                if better {
+                    self.state.best_e_dist_cm = Some(v.e_dist_cm);
+                }
+                better
+            }
+            _ => true,
+        };
+        self.save(&out_dir.join(LAST_CHECKPOINT))?;
+        if is_best {
+            self.save(&out_dir.join(BEST_CHECKPOINT))?;
+        }
+        let seconds = start.elapsed().as_secs_f64();
+        let row = MetricsRow {
+            epoch: self.state.epoch,
+            step: self.state.step,
+            lr: self.lr,
+            seconds,
+            train: train_terms,
+            train_samples,
+            validation,
+            is_best,
+        };
+        MetricsLog::new(out_dir.join(METRICS_LOG)).append(&row)?;
+        Ok(EpochReport {
+            epoch: self.state.epoch,
+            train: train_terms,
+            train_samples,
+            validation,
+            is_best,
+            seconds,
+        })
+    }
+
+    /// Runs epochs until `epochs` are completed (counting those of a resumed checkpoint):
+    /// `train(epoch)` gives the training batches of each epoch (shuffle there), `valid()` the
+    /// validation batches; `on_epoch` sees each report. Returns the reports of this call.
+    pub fn fit<I, J, E, FT, FV, FR>(
+        &mut self,
+        epochs: usize,
+        mut train: FT,
+        mut valid: Option<FV>,
+        out_dir: &Path,
+        mut on_epoch: FR,
+    ) -> Result<Vec<EpochReport>>
+    where
+        I: IntoIterator<Item = std::result::Result<Vec<Sample>, E>>,
+        J: IntoIterator<Item = std::result::Result<Vec<Sample>, E>>,
+        E: Display,
+        FT: FnMut(usize) -> I,
+        FV: FnMut() -> J,
+        FR: FnMut(&EpochReport),
+    {
+        let mut reports = Vec::new();
+        while self.state.epoch < epochs {
+            let epoch = self.state.epoch;
+            let v = valid.as_mut().map(|f| f());
+            let report = self.run_epoch(train(epoch), v, out_dir)?;
+            on_epoch(&report);
+            reports.push(report);
+        }
+        Ok(reports)
+    }
+
+    /// Where [`Trainer::run_epoch`] writes its files under `out_dir`: (last, best, metrics).
+    pub fn output_paths(out_dir: &Path) -> (PathBuf, PathBuf, PathBuf) {
+        (
+            out_dir.join(LAST_CHECKPOINT),
+            out_dir.join(BEST_CHECKPOINT),
+            out_dir.join(METRICS_LOG),
+        )
+    }
+}
