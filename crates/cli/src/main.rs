@@ -5,14 +5,18 @@ mod bench_cmd;
 mod body_cmd;
 mod dataset_cmd;
 mod dataset_show;
+mod drape_cmd;
+mod eval_cmd;
 mod garment_cmd;
 mod garment_sheet;
+mod model_device;
 mod output;
 mod pose_args;
 mod pose_cmd;
 mod shape_args;
 mod simulate_cmd;
 mod simulate_sheet;
+mod train_cmd;
 
 use clap::{Parser, Subcommand};
 
@@ -45,6 +49,12 @@ enum Cmd {
     /// Datasets: check a spec, generate (sharded, resumable), merge, inspect, show.
     #[command(subcommand)]
     Dataset(dataset_cmd::DatasetCmd),
+    /// Drape garments on a body with trained GarNet models (milliseconds, no simulation).
+    Drape(drape_cmd::DrapeArgs),
+    /// Evaluate trained models on a dataset split: the paper's Table 1, Table 2, Figure 4.
+    Eval(eval_cmd::EvalArgs),
+    /// Train a GarNet network for one garment of a dataset.
+    Train(train_cmd::TrainArgs),
     /// Benchmarks measured in one run, reported with ratios to a reference.
     #[command(subcommand)]
     Bench(bench_cmd::BenchCmd),
@@ -60,6 +70,9 @@ fn main() {
         Some(Cmd::Pose(c)) => pose_cmd::run(c),
         Some(Cmd::Simulate(a)) => simulate_cmd::run(a),
         Some(Cmd::Dataset(c)) => dataset_cmd::run(c),
+        Some(Cmd::Drape(a)) => drape_cmd::run(a),
+        Some(Cmd::Eval(a)) => eval_cmd::run(a),
+        Some(Cmd::Train(a)) => train_cmd::run(a),
         Some(Cmd::Bench(c)) => bench_cmd::run(c),
     };
     if let Err(e) = result {

@@ -119,6 +119,13 @@ impl GarmentTemplate {
 
     /// Writes the template to `path` (atomically).
     pub fn save(&self, path: &Path) -> Result<(), GarmentError> {
+        let bytes = self.to_bytes(path)?;
+        geom::io::write_bytes_atomic(path, &bytes)?;
+        Ok(())
+    }
+
+    /// The template as the bytes of a `.garment` file; `path` names it in errors.
+    pub fn to_bytes(&self, path: &Path) -> Result<Vec<u8>, GarmentError> {
         self.validate()?;
         let (n, f, b) = (
             self.mesh.vertices.len(),
@@ -207,18 +214,21 @@ impl GarmentTemplate {
             ("body_phenotype".into(), json(&self.body_phenotype)),
             ("bones".into(), json(&bone_meta)),
         ]);
-        let bytes = safetensors::serialize(views, Some(meta))
-            .map_err(|e| GarmentError::file(path, e.to_string()))?;
-        geom::io::write_bytes_atomic(path, &bytes)?;
-        Ok(())
+        safetensors::serialize(views, Some(meta))
+            .map_err(|e| GarmentError::file(path, e.to_string()))
     }
 
     /// Reads a template written by [`GarmentTemplate::save`]; a malformed file is an
     /// error naming the file and the problem.
     pub fn load(path: &Path) -> Result<Self, GarmentError> {
+        let bytes = std::fs::read(path).map_err(|e| GarmentError::file(path, e.to_string()))?;
+        Self::from_bytes(&bytes, path)
+    }
+
+    /// Reads a template from the bytes of a `.garment` file; `path` names it in errors.
+    pub fn from_bytes(bytes: &[u8], path: &Path) -> Result<Self, GarmentError> {
         let bad = |m: String| GarmentError::file(path, m);
-        let bytes = std::fs::read(path).map_err(|e| bad(e.to_string()))?;
-        let (_, meta) = SafeTensors::read_metadata(&bytes)
+        let (_, meta) = SafeTensors::read_metadata(bytes)
             .map_err(|e| bad(format!("not a garment template: {e}")))?;
         let meta = meta.metadata().clone().unwrap_or_default();
         if meta.get("format").map(String::as_str) != Some(FORMAT) {
@@ -235,7 +245,7 @@ impl GarmentTemplate {
             serde_json::from_str(text)
                 .map_err(|e| GarmentError::file(path, format!("metadata {key}: {e}")))
         }
-        let st = SafeTensors::deserialize(&bytes).map_err(|e| bad(e.to_string()))?;
+        let st = SafeTensors::deserialize(bytes).map_err(|e| bad(e.to_string()))?;
         let data = |name: &str, dtype: Dtype| -> Result<&[u8], GarmentError> {
             let t = st
                 .tensor(name)

@@ -10,6 +10,7 @@
 //! | `template.vertices` | F32 | `[N,3]` | the garment template mesh, metres |
 //! | `template.faces` | U32 | `[F,3]` | its triangles |
 //! | `body.stream` | U32 | `[P]` | the body vertices the body stream sees, farthest-point order |
+//! | `garment.file` | U8 | `[L3]` | optional: the `.garment` template file M is warped with |
 //!
 //! and JSON metadata `format`, `config` ([`GarNetConfig`]), `loss` ([`LossConfig`]),
 //! `state` ([`TrainState`]), `body.n_vertices` (V) and `body.n_centres` (GarNet-Local's kept
@@ -49,6 +50,9 @@ pub struct ModelSetup {
     pub template: geom::TriMesh,
     /// The body points the network sees.
     pub body_sampling: BodySampling,
+    /// The garment template file (`.garment` bytes: weights, rig, template body) the
+    /// network's input M is warped with, so a checkpoint alone can drape; opaque here.
+    pub garment_file: Option<Vec<u8>>,
 }
 
 impl ModelSetup {
@@ -70,7 +74,14 @@ impl ModelSetup {
             config,
             template,
             body_sampling,
+            garment_file: None,
         })
+    }
+
+    /// This setup carrying the garment template file `bytes` (see [`ModelSetup::garment_file`]).
+    pub fn with_garment_file(mut self, bytes: Vec<u8>) -> Self {
+        self.garment_file = Some(bytes);
+        self
     }
 
     /// How samples become this network's inputs.
@@ -215,6 +226,9 @@ pub fn save_checkpoint(
     if let Some(o) = &optim_bytes {
         tensors.push(("optimizer", Dtype::U8, vec![o.len()], o.to_vec()));
     }
+    if let Some(g) = &setup.garment_file {
+        tensors.push(("garment.file", Dtype::U8, vec![g.len()], g.clone()));
+    }
     let meta: HashMap<String, String> = HashMap::from([
         ("format".into(), FORMAT.into()),
         ("config".into(), json(&setup.config)?),
@@ -305,10 +319,16 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint> {
     } else {
         None
     };
+    let garment_file = if names.contains(&"garment.file") {
+        Some(data("garment.file", Dtype::U8)?.to_vec())
+    } else {
+        None
+    };
     let setup = ModelSetup {
         config,
         template,
         body_sampling,
+        garment_file,
     };
     setup.validate().map_err(|e| bad(e.to_string()))?;
     Ok(Checkpoint {

@@ -172,7 +172,8 @@ fn batch_refuses_mismatched_samples() {
 fn checkpoints_round_trip_exactly_and_resume_training() {
     let device = Device::flex();
     let dir = tempfile::tempdir().unwrap();
-    let s = setup(Variant::Local, 60);
+    // The checkpoint also carries an opaque garment file, byte for byte.
+    let s = setup(Variant::Local, 60).with_garment_file((0..=255u8).cycle().take(1000).collect());
     let data = samples(&s, 3);
     let mut trainer = Trainer::new(s.clone(), LossConfig::new(), 1e-3, &device).unwrap();
     for _ in 0..3 {

@@ -19,6 +19,7 @@ mod image;
 mod mesh;
 mod occlusion;
 pub mod palette;
+pub mod plot;
 mod raster;
 mod render;
 mod shading;

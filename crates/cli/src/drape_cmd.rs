@@ -1,0 +1,129 @@
+//! `garnet drape`: a body in, draped garments out, with trained GarNet models. Each model
+//! file carries its garment template, so nothing else is needed: the template is warped
+//! onto the posed body by DQS (the network's input M) and the network predicts the drape.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{anyhow, Context};
+use body::clearance::{clear_limbs, ClearanceOptions};
+use body::{BodyModel, Skinning};
+use clap::Args;
+use garment::warp::warp;
+use garment::GarmentTemplate;
+use geom::TriMesh;
+use model::Draper;
+use render::palette;
+
+use crate::garment_cmd::garment_color;
+use crate::model_device::DeviceArg;
+use crate::output::{write_mesh, write_png};
+use crate::pose_args::PoseArgs;
+use crate::shape_args::ShapeArgs;
+
+/// Arguments of `garnet drape`.
+#[derive(Args, Debug, Clone)]
+pub struct DrapeArgs {
+    /// Trained model files (`.garnet`, from `garnet train`); one garment each.
+    #[arg(long = "model", value_name = "CKPT", required = true, num_args = 1..)]
+    pub models: Vec<PathBuf>,
+    #[command(flatten)]
+    pub shape: ShapeArgs,
+    #[command(flatten)]
+    pub pose: PoseArgs,
+    /// Drape the pose as given: no limb clearance (the models were trained on cleared poses).
+    #[arg(long)]
+    pub keep_pose: bool,
+    /// Output mesh of the draped garment (OBJ, PLY or GLB); with several models, the
+    /// garment's kind is added to the name (`draped-tshirt.glb`).
+    #[arg(long, default_value = "out/draped.glb")]
+    pub out: PathBuf,
+    /// Also write the posed body mesh here.
+    #[arg(long, value_name = "FILE")]
+    pub body_out: Option<PathBuf>,
+    /// Picture of the body wearing the garments.
+    #[arg(long, value_name = "FILE.png")]
+    pub png: Option<PathBuf>,
+    /// Where the networks run.
+    #[arg(long, value_enum, default_value_t = DeviceArg::Cpu)]
+    pub device: DeviceArg,
+}
+
+/// The garment template a checkpoint carries.
+pub fn checkpoint_template(draper: &Draper, path: &Path) -> anyhow::Result<GarmentTemplate> {
+    let bytes = draper.setup().garment_file.as_ref().ok_or_else(|| {
+        anyhow!(
+            "{}: the model carries no garment template (train it with `garnet train`)",
+            path.display()
+        )
+    })?;
+    Ok(GarmentTemplate::from_bytes(bytes, path)?)
+}
+
+/// Runs `garnet drape`.
+pub fn run(args: &DrapeArgs) -> anyhow::Result<()> {
+    let device = args.device.device()?;
+    let body_model = BodyModel::load()?;
+    let target = body_model.shape(&args.shape.phenotype(&body_model)?)?;
+    let (pose, what) = args.pose.pose(&body_model, &target)?;
+    let pose = if args.keep_pose {
+        pose
+    } else {
+        clear_limbs(&target, &pose, &ClearanceOptions::default())?.0
+    };
+    let body = target.posed(&pose, Skinning::Dqs)?;
+    let mut scene: Vec<(TriMesh, [u8; 3])> = Vec::new();
+    let several = args.models.len() > 1;
+    for path in &args.models {
+        let draper =
+            Draper::load(path, &device).with_context(|| format!("loading {}", path.display()))?;
+        let template = checkpoint_template(&draper, path)?;
+        let start = Instant::now();
+        let m = warp(&template, &target, &pose, Skinning::Dqs)?;
+        let warp_ms = start.elapsed().as_secs_f64() * 1e3;
+        let start = Instant::now();
+        let draped = draper
+            .drape(&body.vertices, &m.vertices)
+            .with_context(|| format!("{}: draping", path.display()))?;
+        let net_ms = start.elapsed().as_secs_f64() * 1e3;
+        eprintln!(
+            "{} ({} vertices, GarNet-{}) on a {:.1} cm body, {what}: warp {warp_ms:.1} ms, \
+             network {net_ms:.1} ms",
+            template.kind.name(),
+            draped.len(),
+            draper.setup().config.variant.name(),
+            target.height() * 100.0
+        );
+        let mesh = TriMesh {
+            vertices: draped,
+            faces: template.mesh.faces.clone(),
+        };
+        let out = if several {
+            let stem = args
+                .out
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("draped");
+            let ext = args
+                .out
+                .extension()
+                .and_then(|s| s.to_str())
+                .unwrap_or("glb");
+            args.out
+                .with_file_name(format!("{stem}-{}.{ext}", template.kind.name()))
+        } else {
+            args.out.clone()
+        };
+        write_mesh(&out, &mesh)?;
+        scene.push((mesh, garment_color(&template.kind)));
+    }
+    if let Some(p) = &args.body_out {
+        write_mesh(p, &body)?;
+    }
+    if let Some(png) = &args.png {
+        let mut meshes: Vec<(&TriMesh, [u8; 3])> = vec![(&body, palette::SKIN)];
+        meshes.extend(scene.iter().map(|(m, c)| (m, *c)));
+        write_png(png, &meshes, (480, 720))?;
+    }
+    Ok(())
+}

@@ -1,0 +1,345 @@
+//! `garnet eval`: trained models on a dataset split, as the paper reports them: Table 1
+//! (E_dist in cm, E_norm in degrees, per garment and variant, DQS as a row, plus the share
+//! of vertices inside the body), Figure 4's precision curves (PNG), and Table 2's timing
+//! (network per drape, DQS warp, simulator). Markdown and JSON.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{anyhow, Context};
+use body::{BodyModel, Phenotype, Pose, Skinning};
+use clap::Args;
+use dataset::batches::{BatchOptions, Batches, Order};
+use dataset::Dataset;
+use geom::metrics::{face_normal_angles, precision_curve, vertex_distances};
+use geom::{Bvh, TriMesh};
+use glam::Vec3;
+use model::Draper;
+use render::plot::{Chart, Series};
+use serde::Serialize;
+
+use crate::drape_cmd::checkpoint_template;
+use crate::model_device::DeviceArg;
+use crate::simulate_cmd::write_json;
+
+/// Arguments of `garnet eval`.
+#[derive(Args, Debug, Clone)]
+pub struct EvalArgs {
+    /// Dataset folder.
+    #[arg(long, value_name = "DIR")]
+    pub data: PathBuf,
+    /// Split to evaluate on.
+    #[arg(long, default_value = "test")]
+    pub split: String,
+    /// Trained model files (any garments and variants).
+    #[arg(long = "model", value_name = "CKPT", required = true, num_args = 1..)]
+    pub models: Vec<PathBuf>,
+    /// Output folder: results.md, results.json, precision_dist.png, precision_norm.png.
+    #[arg(long, default_value = "out/eval")]
+    pub out: PathBuf,
+    /// Evaluate at most this many samples per garment.
+    #[arg(long, value_name = "N")]
+    pub max_samples: Option<usize>,
+    /// Where the networks run.
+    #[arg(long, value_enum, default_value_t = DeviceArg::Cpu)]
+    pub device: DeviceArg,
+}
+
+/// One row of Table 1 and its curves.
+#[derive(Serialize)]
+struct Row {
+    garment: String,
+    method: String,
+    samples: usize,
+    e_dist_cm: f32,
+    e_norm_deg: f32,
+    inside_share: f32,
+    /// Share of vertices within each of [`DIST_THRESHOLDS_CM`].
+    dist_curve: Vec<f32>,
+    /// Share of faces within each of [`NORM_THRESHOLDS_DEG`].
+    norm_curve: Vec<f32>,
+}
+
+/// One row of Table 2.
+#[derive(Serialize)]
+struct Timing {
+    garment: String,
+    method: String,
+    vertices: usize,
+    network_ms: f64,
+    dqs_ms: f64,
+    simulator_s: Option<f64>,
+}
+
+/// Thresholds of the distance precision curve, cm.
+fn dist_thresholds() -> Vec<f32> {
+    (0..=50).map(|k| k as f32 * 0.1).collect()
+}
+
+/// Thresholds of the normal precision curve, degrees.
+fn norm_thresholds() -> Vec<f32> {
+    (0..=60).map(|k| k as f32).collect()
+}
+
+/// Accumulates per-vertex distances, per-face angles and inside counts of one method.
+#[derive(Default)]
+struct Errors {
+    dists_cm: Vec<f32>,
+    angles_deg: Vec<f32>,
+    sample_dist: Vec<f32>,
+    sample_norm: Vec<f32>,
+    inside: usize,
+    vertices: usize,
+}
+
+impl Errors {
+    fn add(
+        &mut self,
+        gt: &[Vec3],
+        pred: &[Vec3],
+        faces: &[[u32; 3]],
+        body: &Bvh,
+    ) -> anyhow::Result<()> {
+        let d: Vec<f32> = vertex_distances(gt, pred)?
+            .iter()
+            .map(|m| m * 100.0)
+            .collect();
+        let a: Vec<f32> = face_normal_angles(gt, pred, faces)?
+            .iter()
+            .map(|r| r.to_degrees())
+            .collect();
+        self.sample_dist
+            .push(d.iter().sum::<f32>() / d.len().max(1) as f32);
+        self.sample_norm
+            .push(a.iter().sum::<f32>() / a.len().max(1) as f32);
+        self.inside += body.contains_points(pred).iter().filter(|&&i| i).count();
+        self.vertices += pred.len();
+        self.dists_cm.extend(d);
+        self.angles_deg.extend(a);
+        Ok(())
+    }
+
+    fn row(&self, garment: &str, method: &str) -> Row {
+        let mean = |v: &[f32]| v.iter().sum::<f32>() / v.len().max(1) as f32;
+        Row {
+            garment: garment.into(),
+            method: method.into(),
+            samples: self.sample_dist.len(),
+            e_dist_cm: mean(&self.sample_dist),
+            e_norm_deg: mean(&self.sample_norm),
+            inside_share: self.inside as f32 / self.vertices.max(1) as f32,
+            dist_curve: precision_curve(&self.dists_cm, &dist_thresholds()),
+            norm_curve: precision_curve(&self.angles_deg, &norm_thresholds()),
+        }
+    }
+}
+
+/// The dataset garment whose template has the faces of `template`.
+fn matching_garment(data: &Dataset, split: &str, template: &TriMesh) -> anyhow::Result<String> {
+    for g in &data.manifest().garments {
+        let Some(&first) = data.select(Some(split), Some(&g.name))?.first() else {
+            continue;
+        };
+        let id = data.sample(first)?.record.template;
+        if data.template(&id)?.mesh.faces == template.faces {
+            return Ok(g.name.clone());
+        }
+    }
+    Err(anyhow!(
+        "{}: no garment of split '{split}' has the model's template ({} vertices)",
+        data.dir().display(),
+        template.vertices.len()
+    ))
+}
+
+/// Median of `v` (0 for none).
+fn median(mut v: Vec<f64>) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Runs `garnet eval`.
+pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
+    let device = args.device.device()?;
+    let data = Dataset::open(&args.data)?;
+    let body_faces = data.body_faces()?;
+    let body_model = BodyModel::load()?;
+    let body_rest = body_model.shape(&Phenotype::default())?;
+    let mut rows: Vec<Row> = Vec::new();
+    let mut timings: Vec<Timing> = Vec::new();
+    let mut dqs_done: BTreeMap<String, ()> = BTreeMap::new();
+    for path in &args.models {
+        let draper =
+            Draper::load(path, &device).with_context(|| format!("loading {}", path.display()))?;
+        let template = checkpoint_template(&draper, path)?;
+        let faces = &template.mesh.faces;
+        let garment = matching_garment(&data, &args.split, &template.mesh)?;
+        let mut indices = data.select(Some(&args.split), Some(&garment))?;
+        if let Some(n) = args.max_samples {
+            indices.truncate(n);
+        }
+        let method = format!("GarNet-{}", draper.setup().config.variant.name());
+        eprintln!(
+            "{}: {method} on {} '{garment}' samples",
+            path.display(),
+            indices.len()
+        );
+        let (mut net, mut dqs) = (Errors::default(), Errors::default());
+        let (mut net_ms, mut dqs_ms, mut sim_s) = (Vec::new(), Vec::new(), Vec::new());
+        let opts = BatchOptions {
+            batch_size: 1,
+            order: Order::InOrder,
+            drop_last: false,
+        };
+        for batch in Batches::new(&data, &indices, opts) {
+            for s in batch? {
+                let a = &s.arrays;
+                let start = Instant::now();
+                let pred = draper.drape(&a.body, &a.warped)?;
+                net_ms.push(start.elapsed().as_secs_f64() * 1e3);
+                // The DQS warp of the same pose (its cost does not depend on the shape).
+                let pose = Pose {
+                    root_translation: a.root_translation,
+                    rotations: a.rotations.clone(),
+                };
+                let start = Instant::now();
+                garment::warp::warp(&template, &body_rest, &pose, Skinning::Dqs)?;
+                dqs_ms.push(start.elapsed().as_secs_f64() * 1e3);
+                if let Some(t) = data
+                    .manifest()
+                    .samples
+                    .iter()
+                    .find(|e| e.record.index == s.record.index)
+                    .and_then(|e| e.timing.as_ref())
+                {
+                    sim_s.push(t.drape_s);
+                }
+                let body = Bvh::from_mesh(&TriMesh::new(a.body.clone(), body_faces.clone()))?;
+                net.add(&a.draped, &pred, faces, &body)?;
+                dqs.add(&a.draped, &a.warped, faces, &body)?;
+            }
+        }
+        rows.push(net.row(&garment, &method));
+        if dqs_done.insert(garment.clone(), ()).is_none() {
+            rows.push(dqs.row(&garment, "DQS"));
+        }
+        timings.push(Timing {
+            garment: garment.clone(),
+            method,
+            vertices: template.mesh.vertices.len(),
+            network_ms: median(net_ms),
+            dqs_ms: median(dqs_ms),
+            simulator_s: (!sim_s.is_empty()).then(|| median(sim_s)),
+        });
+    }
+    write_reports(&args.out, &args.split, &rows, &timings)
+}
+
+/// Writes results.md, results.json and the two precision-curve PNGs into `out`.
+fn write_reports(out: &Path, split: &str, rows: &[Row], timings: &[Timing]) -> anyhow::Result<()> {
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let mut md = format!(
+        "# GarNet evaluation (split '{split}')\n\n## Table 1: errors\n\n| garment | method | samples | E_dist (cm) | E_norm (deg) | vertices inside body |\n|---|---|---:|---:|---:|---:|\n"
+    );
+    for r in rows {
+        md += &format!(
+            "| {} | {} | {} | {:.3} | {:.2} | {:.2}% |\n",
+            r.garment,
+            r.method,
+            r.samples,
+            r.e_dist_cm,
+            r.e_norm_deg,
+            r.inside_share * 100.0
+        );
+    }
+    md += "\n## Table 2: time per drape\n\n| garment | method | vertices | network (ms) | DQS warp (ms) | simulator (s) | simulator / network |\n|---|---|---:|---:|---:|---:|---:|\n";
+    for t in timings {
+        let (sim, ratio) = match t.simulator_s {
+            Some(s) => (
+                format!("{s:.2}"),
+                format!("{:.0}x", s * 1e3 / t.network_ms.max(1e-9)),
+            ),
+            None => ("n/a".into(), "n/a".into()),
+        };
+        md += &format!(
+            "| {} | {} | {} | {:.1} | {:.2} | {sim} | {ratio} |\n",
+            t.garment, t.method, t.vertices, t.network_ms, t.dqs_ms
+        );
+    }
+    md += "\nPrecision curves: precision_dist.png (share of vertices within a distance of the \
+           simulated drape), precision_norm.png (share of faces within an angle of its normal).\n";
+    geom::io::write_bytes_atomic(out.join("results.md"), md.as_bytes())?;
+    #[derive(Serialize)]
+    struct Report<'a> {
+        split: &'a str,
+        dist_thresholds_cm: Vec<f32>,
+        norm_thresholds_deg: Vec<f32>,
+        table1: &'a [Row],
+        table2: &'a [Timing],
+    }
+    write_json(
+        &out.join("results.json"),
+        &Report {
+            split,
+            dist_thresholds_cm: dist_thresholds(),
+            norm_thresholds_deg: norm_thresholds(),
+            table1: rows,
+            table2: timings,
+        },
+    )?;
+    let colors = [
+        [31, 119, 180],
+        [255, 127, 14],
+        [44, 160, 44],
+        [214, 39, 40],
+        [148, 103, 189],
+        [140, 86, 75],
+        [227, 119, 194],
+        [127, 127, 127],
+        [188, 189, 34],
+        [23, 190, 207],
+    ];
+    let series = |curve: fn(&Row) -> &Vec<f32>, xs: Vec<f32>| -> Vec<Series> {
+        rows.iter()
+            .enumerate()
+            .map(|(i, r)| Series {
+                name: format!("{} {}", r.garment, r.method),
+                color: colors[i % colors.len()],
+                points: xs.iter().copied().zip(curve(r).iter().copied()).collect(),
+            })
+            .collect()
+    };
+    let chart = |title: &str, x_label: &str, x_max: f32| Chart {
+        title: title.into(),
+        x_label: x_label.into(),
+        y_label: "share".into(),
+        x_range: (0.0, x_max),
+        y_range: (0.0, 1.0),
+        ticks: 5,
+        size: (640, 420),
+    };
+    let dist = chart(
+        "vertex distance precision",
+        "distance to the simulated drape (cm)",
+        5.0,
+    )
+    .draw(&series(|r| &r.dist_curve, dist_thresholds()));
+    let norm = chart(
+        "face normal precision",
+        "normal angle to the simulated drape (deg)",
+        60.0,
+    )
+    .draw(&series(|r| &r.norm_curve, norm_thresholds()));
+    for (img, name) in [(dist, "precision_dist.png"), (norm, "precision_norm.png")] {
+        let p = out.join(name);
+        img.save_png(&p)
+            .with_context(|| format!("writing {}", p.display()))?;
+    }
+    print!("{md}");
+    eprintln!("wrote {}", out.display());
+    Ok(())
+}

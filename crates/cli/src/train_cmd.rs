@@ -1,0 +1,269 @@
+//! `garnet train`: trains a GarNet variant for one garment of a dataset, with validation
+//! each epoch, best and last checkpoints, `--resume`, a progress bar with the loss terms
+//! and a metrics log (`metrics.csv`).
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context};
+use burn::module::Module;
+use clap::{Args, ValueEnum};
+use dataset::batches::{BatchOptions, Batches, Order};
+use dataset::Dataset;
+use indicatif::{ProgressBar, ProgressStyle};
+use model::{
+    BodyTopology, GarNetConfig, LossConfig, ModelSetup, Sample, Trainer, Variant,
+    PAPER_LEARNING_RATE,
+};
+
+use crate::model_device::DeviceArg;
+
+/// Arguments of `garnet train`.
+#[derive(Args, Debug, Clone)]
+pub struct TrainArgs {
+    /// Dataset folder (made by `garnet dataset generate`).
+    #[arg(long, value_name = "DIR")]
+    pub data: PathBuf,
+    /// Garment name in the dataset (tshirt, sweater, jeans unless the spec named them).
+    #[arg(long)]
+    pub garment: String,
+    /// Network variant.
+    #[arg(long, value_enum, default_value_t = VariantArg::Local)]
+    pub variant: VariantArg,
+    /// Epochs to complete (counting those of a resumed run).
+    #[arg(long, default_value_t = 30)]
+    pub epochs: usize,
+    /// Samples per batch.
+    #[arg(long, default_value_t = 8)]
+    pub batch: usize,
+    /// Adam learning rate (the paper: 1e-3).
+    #[arg(long, default_value_t = PAPER_LEARNING_RATE)]
+    pub lr: f64,
+    /// Output folder (checkpoints `best.garnet`, `last.garnet`, `metrics.csv`); default
+    /// `runs/GARMENT-VARIANT`.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Continue from `OUT/last.garnet` (network, optimiser and progress).
+    #[arg(long)]
+    pub resume: bool,
+    /// Train on at most this many training samples (quick runs).
+    #[arg(long, value_name = "N")]
+    pub max_samples: Option<usize>,
+    /// Loss weights: turn a term off for ablations (L_vertex stays).
+    #[arg(long)]
+    pub no_pen: bool,
+    /// See --no-pen.
+    #[arg(long)]
+    pub no_norm: bool,
+    /// See --no-pen.
+    #[arg(long)]
+    pub no_bend: bool,
+    /// Seed of the per-epoch shuffle.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Where the network runs.
+    #[arg(long, value_enum, default_value_t = DeviceArg::Cpu)]
+    pub device: DeviceArg,
+}
+
+/// The three GarNet variants on the command line.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VariantArg {
+    /// GarNet-Local (global and local body features, mesh convolutions).
+    Local,
+    /// GarNet-Global (global body features, mesh convolutions).
+    Global,
+    /// GarNet-Naive (two-stream PointNet, no mesh convolution).
+    Naive,
+}
+
+impl From<VariantArg> for Variant {
+    fn from(v: VariantArg) -> Self {
+        match v {
+            VariantArg::Local => Variant::Local,
+            VariantArg::Global => Variant::Global,
+            VariantArg::Naive => Variant::Naive,
+        }
+    }
+}
+
+/// A dataset's samples of one garment and split, as the network's training samples.
+pub struct GarmentSplit<'a> {
+    data: &'a Dataset,
+    topology: BodyTopology,
+    /// Stored sample indices.
+    pub indices: Vec<u64>,
+}
+
+impl<'a> GarmentSplit<'a> {
+    /// The samples of `garment` in `split` of `data`; errors when there are none.
+    pub fn new(data: &'a Dataset, split: &str, garment: &str) -> anyhow::Result<Self> {
+        let indices = data.select(Some(split), Some(garment))?;
+        if indices.is_empty() {
+            bail!(
+                "{}: no '{garment}' samples in split '{split}'",
+                data.dir().display()
+            );
+        }
+        let faces = data.body_faces()?;
+        let first = data.sample(indices[0])?;
+        let topology = BodyTopology::new(first.arrays.body.len(), faces)?;
+        Ok(Self {
+            data,
+            topology,
+            indices,
+        })
+    }
+
+    /// The garment template the samples share (metres).
+    pub fn template(&self) -> anyhow::Result<std::sync::Arc<garment::GarmentTemplate>> {
+        let first = self.data.sample(self.indices[0])?;
+        Ok(self.data.template(&first.record.template)?)
+    }
+
+    /// The first sample's posed body `[V]` (metres): the reference of the body sampling.
+    pub fn reference_body(&self) -> anyhow::Result<Vec<glam::Vec3>> {
+        Ok(self.data.sample(self.indices[0])?.arrays.body)
+    }
+
+    /// Batches of the samples in `order`, converted to network samples (with targets).
+    pub fn batches(
+        &self,
+        batch_size: usize,
+        order: Order,
+    ) -> impl Iterator<Item = Result<Vec<Sample>, String>> + '_ {
+        let opts = BatchOptions {
+            batch_size,
+            order,
+            drop_last: false,
+        };
+        Batches::new(self.data, &self.indices, opts).map(move |b| {
+            let b = b.map_err(|e| e.to_string())?;
+            b.into_iter()
+                .map(|s| {
+                    Sample::new(
+                        s.arrays.body,
+                        &self.topology,
+                        s.arrays.warped,
+                        Some(s.arrays.draped),
+                    )
+                    .map_err(|e| format!("sample {}: {e}", s.record.index))
+                })
+                .collect()
+        })
+    }
+}
+
+/// Runs `garnet train`.
+pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
+    let data = Dataset::open(&args.data)?;
+    let mut train = GarmentSplit::new(&data, "train", &args.garment)?;
+    if let Some(n) = args.max_samples {
+        train.indices.truncate(n.max(1));
+    }
+    let valid = GarmentSplit::new(&data, "val", &args.garment).ok();
+    let variant: Variant = args.variant.into();
+    let out = args.out.clone().unwrap_or_else(|| {
+        PathBuf::from("runs").join(format!("{}-{}", args.garment, variant.name()))
+    });
+    let device = args.device.device()?;
+    let last = out.join(model::trainer::LAST_CHECKPOINT);
+    let mut trainer = if args.resume && last.is_file() {
+        eprintln!("resuming from {}", last.display());
+        Trainer::resume(&last, Some(args.lr), &device)
+            .with_context(|| format!("resuming {}", last.display()))?
+    } else {
+        if args.resume {
+            eprintln!("no {} yet: starting afresh", last.display());
+        }
+        let template = train.template()?;
+        let garment_file = template.to_bytes(&args.data)?;
+        let setup = ModelSetup::new(
+            GarNetConfig::new(variant),
+            template.mesh.clone(),
+            &train.reference_body()?,
+        )?
+        .with_garment_file(garment_file);
+        Trainer::new(setup, loss_config(args), args.lr, &device)?
+    };
+    let params = trainer.model().num_params();
+    eprintln!(
+        "training GarNet-{} ({params} parameters) on {} '{}' samples ({} validation), \
+         batch {}, lr {}, into {}",
+        variant.name(),
+        train.indices.len(),
+        args.garment,
+        valid.as_ref().map_or(0, |v| v.indices.len()),
+        args.batch,
+        args.lr,
+        out.display()
+    );
+    let batches_per_epoch = train.indices.len().div_ceil(args.batch.max(1)) as u64;
+    let bar = ProgressBar::new(batches_per_epoch);
+    bar.set_style(
+        ProgressStyle::with_template(
+            "epoch {prefix} [{bar:30}] {pos}/{len} batches {per_sec} eta {eta} {msg}",
+        )?
+        .progress_chars("=> "),
+    );
+    let seed = args.seed;
+    let train_batches = |epoch: usize| {
+        bar.set_prefix((epoch + 1).to_string());
+        bar.reset();
+        let bar = bar.clone();
+        train
+            .batches(
+                args.batch,
+                Order::Shuffled {
+                    seed,
+                    epoch: epoch as u64,
+                },
+            )
+            .inspect(move |_| bar.inc(1))
+    };
+    let valid_batches = valid
+        .as_ref()
+        .map(|v| move || v.batches(args.batch, Order::InOrder));
+    trainer.fit(args.epochs, train_batches, valid_batches, &out, |r| {
+        let v = r.validation.map_or(String::new(), |v| {
+            format!(
+                ", val E_dist {:.3} cm E_norm {:.2} deg",
+                v.e_dist_cm, v.e_norm_deg
+            )
+        });
+        bar.suspend(|| eprintln!(
+            "epoch {} ({:.1} s): loss {:.3e} (vertex {:.3e} pen {:.3e} norm {:.3e} bend {:.3e}){v}{}",
+            r.epoch,
+            r.seconds,
+            r.train.total,
+            r.train.vertex,
+            r.train.pen,
+            r.train.norm,
+            r.train.bend,
+            if r.is_best { " *best" } else { "" }
+        ))
+    })?;
+    bar.finish_and_clear();
+    let (last, best, metrics) = Trainer::output_paths(&out);
+    eprintln!(
+        "wrote {}, {} and {}",
+        best.display(),
+        last.display(),
+        metrics.display()
+    );
+    Ok(())
+}
+
+/// The paper's loss weights, with the terms `args` turned off set to zero.
+fn loss_config(args: &TrainArgs) -> LossConfig {
+    let mut cfg = LossConfig::new();
+    if args.no_pen {
+        cfg.pen = 0.0;
+    }
+    if args.no_norm {
+        cfg.norm = 0.0;
+    }
+    if args.no_bend {
+        cfg.bend = 0.0;
+    }
+    cfg
+}

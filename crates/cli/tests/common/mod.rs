@@ -1,0 +1,41 @@
+//! Helpers shared by the CLI integration tests: run the `garnet` binary, expect success
+//! or a clean failure.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Runs `garnet` with `args`.
+pub fn garnet(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_garnet"))
+        .args(args)
+        .output()
+        .expect("garnet runs")
+}
+
+/// Runs `garnet`, asserting success; stdout then stderr.
+pub fn ok(args: &[&str]) -> String {
+    let out = garnet(args);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "garnet {args:?} failed:\n{stderr}");
+    String::from_utf8_lossy(&out.stdout).into_owned() + &stderr
+}
+
+/// Runs `garnet`, asserting a failure without a panic; stderr.
+pub fn fails(args: &[&str]) -> String {
+    let out = garnet(args);
+    assert!(!out.status.success(), "garnet {args:?} should fail");
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    stderr
+}
+
+/// A path as `&str`.
+pub fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// The repository root.
+pub fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}

@@ -1,0 +1,218 @@
+//! Integration tests of `garnet train`, `garnet eval` and `garnet drape` on a small
+//! dataset of coarse T-shirts (generated once for all of them).
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use common::{fails, ok, s};
+
+/// 3 bodies (train, val, test) x T-shirt in 2 poses: 6 samples of an 8 cm T-shirt.
+const SPEC: &str = r#"
+name = "model-cli"
+seed = 4
+shard_size = 2
+[bodies]
+count = 3
+[[garments]]
+kind = "tshirt"
+edge = 0.08
+poses_per_body = 2
+[[poses.procedural]]
+kind = "walk"
+count = 4
+[splits.bodies]
+train = 1
+val = 1
+test = 1
+[simulator]
+morph_steps = 2
+pose_steps = 3
+max_settle_steps = 5
+iterations = 2
+max_penetration = 0.5
+"#;
+
+/// The dataset folder, generated on first use (kept in a folder that lives as long as the
+/// test process).
+fn dataset() -> &'static Path {
+    static DIR: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
+    &DIR.get_or_init(|| {
+        let tmp = tempfile::tempdir().unwrap();
+        let spec = tmp.path().join("spec.toml");
+        std::fs::write(&spec, SPEC).unwrap();
+        let data = tmp.path().join("data");
+        ok(&[
+            "dataset",
+            "generate",
+            s(&spec),
+            "--out",
+            s(&data),
+            "--jobs",
+            "2",
+        ]);
+        (tmp, data)
+    })
+    .1
+}
+
+#[test]
+fn train_resume_eval_and_drape() {
+    let data = dataset();
+    let tmp = tempfile::tempdir().unwrap();
+    let local = tmp.path().join("local");
+    let args = |epochs: &str| {
+        vec![
+            "train",
+            "--data",
+            s(data),
+            "--garment",
+            "tshirt",
+            "--variant",
+            "local",
+            "--epochs",
+            epochs,
+            "--batch",
+            "2",
+            "--out",
+            s(&local),
+        ]
+        .into_iter()
+        .map(String::from)
+        .collect::<Vec<_>>()
+    };
+    let log = ok(&as_str(&args("2")));
+    assert!(
+        log.contains("epoch 2") && log.contains("val E_dist"),
+        "{log}"
+    );
+    let metrics = local.join("metrics.csv");
+    let rows = |p: &Path| std::fs::read_to_string(p).unwrap().lines().count();
+    assert_eq!(rows(&metrics), 3, "header and two epochs");
+    for f in ["best.garnet", "last.garnet"] {
+        assert!(local.join(f).is_file(), "{f}");
+    }
+    // Resume to three epochs: one more row.
+    let mut resume = args("3");
+    resume.push("--resume".into());
+    let log = ok(&as_str(&resume));
+    assert!(log.contains("resuming"), "{log}");
+    assert_eq!(rows(&metrics), 4);
+
+    let naive = tmp.path().join("naive");
+    ok(&[
+        "train",
+        "--data",
+        s(data),
+        "--garment",
+        "tshirt",
+        "--variant",
+        "naive",
+        "--epochs",
+        "1",
+        "--out",
+        s(&naive),
+    ]);
+
+    // Table 1 / Table 2 / precision curves.
+    let eval = tmp.path().join("eval");
+    let best = local.join("best.garnet");
+    let report = ok(&[
+        "eval",
+        "--data",
+        s(data),
+        "--split",
+        "test",
+        "--model",
+        s(&best),
+        s(&naive.join("best.garnet")),
+        "--out",
+        s(&eval),
+    ]);
+    for row in [
+        "GarNet-local",
+        "GarNet-naive",
+        "| tshirt | DQS |",
+        "simulator / network",
+    ] {
+        assert!(report.contains(row), "{row} missing:\n{report}");
+    }
+    for f in [
+        "results.md",
+        "results.json",
+        "precision_dist.png",
+        "precision_norm.png",
+    ] {
+        assert!(eval.join(f).is_file(), "{f}");
+    }
+
+    // Draping needs only the model file.
+    let out = tmp.path().join("draped.obj");
+    let png = tmp.path().join("draped.png");
+    let log = ok(&[
+        "drape",
+        "--model",
+        s(&best),
+        "--random-shape",
+        "2",
+        "--pose-procedural",
+        "3",
+        "--out",
+        s(&out),
+        "--png",
+        s(&png),
+    ]);
+    assert!(log.contains("network"), "{log}");
+    let draped = geom::io::read_mesh(&out).unwrap();
+    let template_vertices = std::fs::read_dir(data.join("templates"))
+        .unwrap()
+        .map(|e| garment::GarmentTemplate::load(&e.unwrap().path()).unwrap())
+        .next()
+        .unwrap()
+        .mesh
+        .vertices
+        .len();
+    assert_eq!(draped.vertices.len(), template_vertices);
+    assert!(png.is_file());
+}
+
+#[test]
+fn drape_and_eval_refuse_what_does_not_fit() {
+    let data = dataset();
+    let tmp = tempfile::tempdir().unwrap();
+    // A garment template is not a model.
+    let template = std::fs::read_dir(data.join("templates"))
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    let err = fails(&[
+        "drape",
+        "--model",
+        s(&template),
+        "--out",
+        s(&tmp.path().join("x.obj")),
+    ]);
+    assert!(err.contains(s(&template)), "{err}");
+    // No such garment in the dataset.
+    let err = fails(&[
+        "train",
+        "--data",
+        s(data),
+        "--garment",
+        "jeans",
+        "--epochs",
+        "1",
+    ]);
+    assert!(err.contains("jeans") && err.contains("tshirt"), "{err}");
+    // A missing model file.
+    let err = fails(&["eval", "--data", s(data), "--model", "nope.garnet"]);
+    assert!(err.contains("nope.garnet"), "{err}");
+}
+
+/// `v` as the `&str` arguments [`ok`] takes.
+fn as_str(v: &[String]) -> Vec<&str> {
+    v.iter().map(String::as_str).collect()
+}

@@ -1,0 +1,149 @@
+//! Line charts (precision curves and the like) drawn with the crate's own text, so a
+//! report needs no font files or plotting stack.
+
+use crate::text::{draw_text, text_size};
+use crate::Image;
+
+/// One curve of a chart: its name in the legend, colour and points `(x, y)` in data units.
+#[derive(Clone, Debug)]
+pub struct Series {
+    /// Legend text.
+    pub name: String,
+    /// Line colour.
+    pub color: [u8; 3],
+    /// Points in data units, in drawing order.
+    pub points: Vec<(f32, f32)>,
+}
+
+/// A line chart: axes from `x_range` and `y_range` (data units), `ticks` tick marks per
+/// axis, labels, a title and a legend. `size`: image width and height in pixels.
+#[derive(Clone, Debug)]
+pub struct Chart {
+    /// Title above the plot.
+    pub title: String,
+    /// Label of the horizontal axis.
+    pub x_label: String,
+    /// Label of the vertical axis.
+    pub y_label: String,
+    /// Horizontal data range.
+    pub x_range: (f32, f32),
+    /// Vertical data range.
+    pub y_range: (f32, f32),
+    /// Tick intervals per axis.
+    pub ticks: u32,
+    /// Image size in pixels.
+    pub size: (u32, u32),
+}
+
+const INK: [u8; 3] = [40, 40, 40];
+const GRID: [u8; 3] = [225, 225, 225];
+const PAPER: [u8; 3] = [255, 255, 255];
+
+impl Chart {
+    /// Draws `series` into a new image.
+    pub fn draw(&self, series: &[Series]) -> Image {
+        let (w, h) = self.size;
+        let mut img = Image::new(w, h, PAPER);
+        let (left, right, top, bottom) = (70i64, 20i64, 36i64, 50i64);
+        let (pw, ph) = (
+            (w as i64 - left - right).max(1),
+            (h as i64 - top - bottom).max(1),
+        );
+        let to_px = |x: f32, y: f32| -> (f32, f32) {
+            let (x0, x1) = self.x_range;
+            let (y0, y1) = self.y_range;
+            let u = (x - x0) / (x1 - x0).max(f32::EPSILON);
+            let v = (y - y0) / (y1 - y0).max(f32::EPSILON);
+            (
+                left as f32 + u * pw as f32,
+                (top + ph) as f32 - v * ph as f32,
+            )
+        };
+        let ticks = self.ticks.max(1);
+        for k in 0..=ticks {
+            let t = k as f32 / ticks as f32;
+            let x = left + (t * pw as f32) as i64;
+            let y = top + ph - (t * ph as f32) as i64;
+            img.fill_rect(x, top, 1, ph as u32, GRID);
+            img.fill_rect(left, y, pw as u32, 1, GRID);
+            let xv = self.x_range.0 + t * (self.x_range.1 - self.x_range.0);
+            let yv = self.y_range.0 + t * (self.y_range.1 - self.y_range.0);
+            let xs = format!("{xv:.4}")
+                .trim_end_matches('0')
+                .trim_end_matches('.')
+                .to_string();
+            let ys = format!("{yv:.4}")
+                .trim_end_matches('0')
+                .trim_end_matches('.')
+                .to_string();
+            let (tw, _) = text_size(&xs, 1);
+            draw_text(&mut img, x - tw as i64 / 2, top + ph + 6, &xs, 1, INK);
+            let (tw, _) = text_size(&ys, 1);
+            draw_text(&mut img, left - 6 - tw as i64, y - 4, &ys, 1, INK);
+        }
+        img.fill_rect(left, top, 1, ph as u32, INK);
+        img.fill_rect(left, top + ph, pw as u32, 1, INK);
+        let (tw, _) = text_size(&self.title, 2);
+        draw_text(&mut img, (w as i64 - tw as i64) / 2, 8, &self.title, 2, INK);
+        let (tw, _) = text_size(&self.x_label, 1);
+        draw_text(
+            &mut img,
+            left + (pw - tw as i64) / 2,
+            h as i64 - 20,
+            &self.x_label,
+            1,
+            INK,
+        );
+        draw_text(&mut img, 4, top - 14, &self.y_label, 1, INK);
+        for (i, s) in series.iter().enumerate() {
+            for pair in s.points.windows(2) {
+                let (a, b) = (to_px(pair[0].0, pair[0].1), to_px(pair[1].0, pair[1].1));
+                line(&mut img, a, b, s.color);
+            }
+            let y = top + 10 + 14 * i as i64;
+            let x = left + pw - 150;
+            img.fill_rect(x, y + 3, 16, 3, s.color);
+            draw_text(&mut img, x + 22, y, &s.name, 1, INK);
+        }
+        img
+    }
+}
+
+/// A 2-pixel-wide line from `a` to `b` (pixels), clipped to the image.
+fn line(img: &mut Image, a: (f32, f32), b: (f32, f32), color: [u8; 3]) {
+    let steps = ((b.0 - a.0).abs().max((b.1 - a.1).abs()).ceil() as usize).max(1);
+    for k in 0..=steps {
+        let t = k as f32 / steps as f32;
+        let (x, y) = (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
+        img.fill_rect(x.round() as i64, y.round() as i64, 2, 2, color);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_rising_line_is_drawn_from_lower_left_to_upper_right() {
+        let chart = Chart {
+            title: "t".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            x_range: (0.0, 1.0),
+            y_range: (0.0, 1.0),
+            ticks: 4,
+            size: (300, 200),
+        };
+        let red = [255, 0, 0];
+        let img = chart.draw(&[Series {
+            name: "s".into(),
+            color: red,
+            points: vec![(0.0, 0.0), (1.0, 1.0)],
+        }]);
+        // Plot area: x 70..280, y 36..150. The line passes its centre, not its corners
+        // above the diagonal.
+        assert_eq!(img.pixel(175, 93), red);
+        assert_ne!(img.pixel(90, 50), red);
+        assert!(img.count_not(PAPER) > 500);
+    }
+}
