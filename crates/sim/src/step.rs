@@ -42,7 +42,7 @@ const REFACTOR_STALE: usize = 50;
 /// Every this many steps, every vertex away from the surface gets the exact inside test
 /// (a vertex pressed deeper than the contact reach, as in an armpit closing on it, is
 /// otherwise never seen again).
-const FULL_INSIDE_CHECK: u64 = 5;
+const FULL_INSIDE_CHECK: u64 = 20;
 
 impl ClothSim {
     /// Advances the simulation by one time step `params().dt`, colliding with `collider` if
@@ -277,10 +277,15 @@ fn project_out(
                 return None;
             }
             let xi = x1[i];
+            let travel = (xi - x0[i]).length() + max_disp;
+            // Far from the body at the start and not moved enough to reach it: no query
+            // (the distance at the end is at least the start distance minus the travel).
+            if !full && dist0[i] - travel > reach {
+                return None;
+            }
             let hit = match c.surface_within(xi, reach) {
                 Some(hit) => hit,
                 None => {
-                    let travel = (xi - x0[i]).length() + max_disp;
                     if (!full && travel < dist0[i]) || !c.contains_cur(xi) {
                         return None;
                     }
