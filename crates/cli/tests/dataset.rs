@@ -207,7 +207,7 @@ fn generate_resume_merge_info_show() {
         s(&png),
     ]);
     let image = render::Image::from_png(&png).unwrap();
-    assert!(image.width >= 900 && image.count_not(image.pixel(0, 0)) > 20_000);
+    assert!(image.width >= 700 && image.count_not(image.pixel(0, 0)) > 20_000);
     let err = fails(&[
         "dataset",
         "show",
@@ -218,6 +218,23 @@ fn generate_resume_merge_info_show() {
         s(&png),
     ]);
     assert!(err.contains("sample 99 is not stored"), "{err}");
+    // Three random samples: three rows.
+    ok(&[
+        "dataset",
+        "show",
+        s(&merged),
+        "--random",
+        "3",
+        "--png",
+        s(&png),
+    ]);
+    let three = render::Image::from_png(&png).unwrap();
+    assert!(
+        three.height > 2 * image.height,
+        "{} vs {}",
+        three.height,
+        image.height
+    );
     // A damaged shard is named.
     let shard = merged.join("shards/shard-000002.safetensors");
     let mut bytes = std::fs::read(&shard).unwrap();
