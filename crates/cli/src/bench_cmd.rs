@@ -24,12 +24,23 @@ pub enum BenchCmd {
         #[arg(long, default_value_t = 5)]
         seed: u64,
     },
+    /// GarNet: forward time per drape of each variant at two garment sizes, and a
+    /// training step, against the DQS warp of the 1 cm T-shirt.
+    Model {
+        /// Repetitions per measurement (the median is reported).
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+        /// Garment vertex counts (comma-separated).
+        #[arg(long, value_delimiter = ',', default_value = "3000,10000")]
+        sizes: Vec<usize>,
+    },
 }
 
 pub fn run(cmd: &BenchCmd) -> anyhow::Result<()> {
     match cmd {
         BenchCmd::Body { repeat } => bench_body(*repeat.max(&3)),
         BenchCmd::Sim { edge, seed } => bench_sim(*edge, *seed),
+        BenchCmd::Model { runs, sizes } => crate::bench_model::bench_model(*runs, sizes),
     }
 }
 
@@ -107,22 +118,53 @@ fn bench_body(repeat: usize) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// A T-shirt of `edge` metres, the template body, a random body (`seed`) in a procedural
+/// walk pose, and the median time of the DQS warp of the T-shirt onto it (the reference of
+/// the simulator and network benchmarks).
+pub struct TshirtCase {
+    pub template: garment::GarmentTemplate,
+    pub template_body: body::ShapedBody,
+    pub target: body::ShapedBody,
+    pub pose: Pose,
+    pub warp: Duration,
+}
+
+impl TshirtCase {
+    pub fn new(model: &BodyModel, edge: f32, seed: u64) -> anyhow::Result<Self> {
+        use body::pose::{PoseKind, ProceduralPoseGenerator};
+        use body::shape_sampler::ShapeDistribution;
+        use garment::{build_template, CutParams, GarmentKind};
+
+        let kind = GarmentKind::Tshirt;
+        let template = build_template(model, &kind, &CutParams::default_for(&kind), edge)?;
+        let template_body = model.shape(&template.body_phenotype)?;
+        let target = model.shape(&ShapeDistribution::default().sample(model, seed)?.phenotype)?;
+        let mut generator = ProceduralPoseGenerator::new(seed, PoseKind::Walk);
+        let pose = body::self_contact::sample_valid_pose(&target, &mut generator, 200)?;
+        let warp = median_time(20, || {
+            garment::warp::warp(&template, &target, &pose, Skinning::Dqs).expect("warp")
+        });
+        Ok(Self {
+            template,
+            template_body,
+            target,
+            pose,
+            warp,
+        })
+    }
+}
+
 fn bench_sim(edge: f32, seed: u64) -> anyhow::Result<()> {
-    use body::pose::{PoseKind, ProceduralPoseGenerator};
-    use body::shape_sampler::ShapeDistribution;
-    use garment::{build_template, CutParams, GarmentKind};
     use sim::drape::{drape, DrapeOptions};
 
     let model = BodyModel::load()?;
-    let kind = GarmentKind::Tshirt;
-    let template = build_template(&model, &kind, &CutParams::default_for(&kind), edge)?;
-    let template_body = model.shape(&template.body_phenotype)?;
-    let target = model.shape(&ShapeDistribution::default().sample(&model, seed)?.phenotype)?;
-    let mut generator = ProceduralPoseGenerator::new(seed, PoseKind::Walk);
-    let pose = body::self_contact::sample_valid_pose(&target, &mut generator, 200)?;
-    let warp = median_time(20, || {
-        garment::warp::warp(&template, &target, &pose, Skinning::Dqs).expect("warp")
-    });
+    let TshirtCase {
+        template,
+        template_body,
+        target,
+        pose,
+        warp,
+    } = TshirtCase::new(&model, edge, seed)?;
     // The bench reports the penetration instead of failing on it.
     let opts = DrapeOptions {
         max_penetration: f32::INFINITY,

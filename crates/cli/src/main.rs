@@ -2,6 +2,7 @@
 
 mod assets_cmd;
 mod bench_cmd;
+mod bench_model;
 mod body_cmd;
 mod dataset_cmd;
 mod dataset_show;

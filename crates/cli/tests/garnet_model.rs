@@ -216,3 +216,16 @@ fn drape_and_eval_refuse_what_does_not_fit() {
 fn as_str(v: &[String]) -> Vec<&str> {
     v.iter().map(String::as_str).collect()
 }
+
+#[test]
+fn bench_model_reports_every_variant_against_the_dqs_warp() {
+    let out = ok(&["bench", "model", "--runs", "1", "--sizes", "300"]);
+    assert!(out.contains("DQS warp (reference)"), "{out}");
+    for variant in ["| local |", "| global |", "| naive |"] {
+        let rows = out.lines().filter(|l| l.contains(variant)).count();
+        assert_eq!(
+            rows, 2,
+            "{variant}: a drape row and a training-step row\n{out}"
+        );
+    }
+}

@@ -1,4 +1,4 @@
-//! Timing helpers (used by `garnet bench model` and `examples/bench.rs`): forward time per
+//! Timing helpers (used by `garnet bench model`): forward time per
 //! drape and training-step time on synthetic inputs of chosen sizes.
 
 use std::time::Instant;
