@@ -122,14 +122,20 @@ fn bench_body(repeat: usize) -> anyhow::Result<()> {
 /// walk pose, and the median time of the DQS warp of the T-shirt onto it (the reference of
 /// the simulator and network benchmarks).
 pub struct TshirtCase {
+    /// The T-shirt template (metres).
     pub template: garment::GarmentTemplate,
+    /// The body the template was made on.
     pub template_body: body::ShapedBody,
+    /// The random body.
     pub target: body::ShapedBody,
+    /// Its procedural walk pose (free of self-intersection).
     pub pose: Pose,
+    /// Median wall time of the DQS warp of the template onto the posed target.
     pub warp: Duration,
 }
 
 impl TshirtCase {
+    /// Builds the case: template with `edge` metres, random shape and pose from `seed`.
     pub fn new(model: &BodyModel, edge: f32, seed: u64) -> anyhow::Result<Self> {
         use body::pose::{PoseKind, ProceduralPoseGenerator};
         use body::shape_sampler::ShapeDistribution;
