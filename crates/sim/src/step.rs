@@ -257,7 +257,8 @@ fn find_contacts(
 /// The free vertices of `x1` (`[N]`) inside the body or closer to it than `to` (metres) at the
 /// end of the step, each with where it goes (`to` outside the surface) and the outward
 /// direction. Vertices with no surface within `reach` are outside unless they may have
-/// travelled farther than their start distance `dist0`, when the winding test decides.
+/// travelled farther than their start distance `dist0`, when the winding test decides;
+/// with `full`, the winding test decides for every vertex with no surface within `reach`.
 fn project_out(
     sim: &ClothSim,
     c: &BodyCollider,
