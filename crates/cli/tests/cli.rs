@@ -1,37 +1,14 @@
 //! Integration tests of the `garnet` commands on small inputs.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn garnet(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_garnet"))
-        .args(args)
-        .output()
-        .expect("garnet runs")
-}
-
-fn ok(args: &[&str]) -> String {
-    let out = garnet(args);
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(out.status.success(), "garnet {args:?} failed:\n{stderr}");
-    String::from_utf8_lossy(&out.stdout).into_owned() + &stderr
-}
-
-fn fails(args: &[&str]) -> String {
-    let out = garnet(args);
-    assert!(!out.status.success(), "garnet {args:?} should fail");
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    stderr
-}
+use common::{fails, ok, repo, s};
+use std::path::PathBuf;
+use std::process::Command;
 
 fn mocap() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/mocap/cmu");
+    let dir = repo().join("../shared/mocap/cmu");
     dir.is_dir().then_some(dir)
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
 }
 
 #[test]
