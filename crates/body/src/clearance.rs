@@ -187,7 +187,7 @@ pub fn clear_limbs(
             };
             let turn = Quat::from_axis_angle(axis, opts.step);
             // The bones below keep their rotation relative to this one.
-            for c in std::iter::once(b).chain(descendants(body, b)) {
+            for c in body.rig.limb(b) {
                 world[c] = (turn * world[c]).normalize();
             }
             turned[s] += opts.step;
@@ -212,7 +212,7 @@ pub fn clear_limbs(
             }
             if !too_buried(&burial, s) || *stale > PATIENCE {
                 // Done: this segment's chain goes back to its best angle.
-                for c in std::iter::once(bones[s]).chain(descendants(body, bones[s])) {
+                for c in body.rig.limb(bones[s]) {
                     world[c] = rotations[c];
                 }
                 best[s] = None;
@@ -222,7 +222,7 @@ pub fn clear_limbs(
     // Segments still turning at the end keep their best angle too.
     for s in 0..8 {
         if let Some((_, rotations, _)) = &best[s] {
-            for c in std::iter::once(bones[s]).chain(descendants(body, bones[s])) {
+            for c in body.rig.limb(bones[s]) {
                 world[c] = rotations[c];
             }
         }
@@ -232,15 +232,4 @@ pub fn clear_limbs(
         segment_burial(&body.posed(&pose, Skinning::Dqs)?, &segments)?.map(|b| b.0);
     report.turned = best_turn;
     Ok((pose, report))
-}
-
-/// Every bone below `bone` in the rig (not `bone` itself).
-fn descendants(body: &ShapedBody, bone: usize) -> Vec<usize> {
-    let mut out = Vec::new();
-    let mut stack: Vec<usize> = body.rig.children(bone).collect();
-    while let Some(c) = stack.pop() {
-        out.push(c);
-        stack.extend(body.rig.children(c));
-    }
-    out
 }

@@ -173,6 +173,28 @@ impl Rig {
             .map(|(j, _)| j)
     }
 
+    /// Bone `i` and every bone below it (children, their children...): the limb it moves.
+    pub fn limb(&self, i: usize) -> Vec<usize> {
+        let mut out = vec![i];
+        let mut stack: Vec<usize> = self.children(i).collect();
+        while let Some(c) = stack.pop() {
+            out.push(c);
+            stack.extend(self.children(c));
+        }
+        out
+    }
+
+    /// Swings a limb rigidly: sets the world rotation deltas `world` (`[B]`) of `bone` and
+    /// every bone below it to the rotation that turns `bone`'s rest direction (head to tail)
+    /// to `dir` (any length). [`Pose::from_world_rotations`] makes the pose.
+    pub fn swing_limb(&self, world: &mut [Quat], bone: usize, dir: Vec3) {
+        let b = &self.bones[bone];
+        let swing = Quat::from_rotation_arc((b.tail - b.head).normalize(), dir.normalize());
+        for c in self.limb(bone) {
+            world[c] = swing;
+        }
+    }
+
     /// World-space rotation deltas `[B]` of every bone for `pose` (rest -> posed).
     pub fn world_rotations(&self, pose: &Pose) -> Vec<Quat> {
         let mut world: Vec<Quat> = Vec::with_capacity(self.bones.len());

@@ -241,23 +241,8 @@ fn self_contact_flags_an_arm_through_the_torso_but_not_the_rest_pose() {
         .unwrap();
     let contact = SelfContact::new(&body);
     assert_eq!(contact.count_intersections(&body.mesh), 0, "rest pose");
-    let rig = &body.rig;
-    let arm = rig.index("LeftArm").unwrap();
-    let (head, tail) = (rig.bones[arm].head, rig.bones[arm].tail);
     // Swing the left arm (and everything below it) across the chest.
-    let swing = Quat::from_rotation_arc(
-        (tail - head).normalize(),
-        Vec3::new(-1.0, -0.1, 0.05).normalize(),
-    );
-    let mut world = vec![Quat::IDENTITY; rig.len()];
-    let mut below = vec![false; rig.len()];
-    for (b, bone) in rig.bones.iter().enumerate() {
-        below[b] = b == arm || bone.parent.is_some_and(|p| below[p]);
-        if below[b] {
-            world[b] = swing;
-        }
-    }
-    let pose = Pose::from_world_rotations(rig, &world, Vec3::ZERO);
+    let pose = left_arm_along(&body, Vec3::new(-1.0, -0.1, 0.05));
     let posed = body.posed(&pose, Skinning::Dqs).unwrap();
     assert!(contact.count_intersections(&posed) > 20);
 }
@@ -265,17 +250,8 @@ fn self_contact_flags_an_arm_through_the_torso_but_not_the_rest_pose() {
 /// A pose of `body` with the left arm (and everything below it) pointing along `dir`.
 fn left_arm_along(body: &body::ShapedBody, dir: Vec3) -> Pose {
     let rig = &body.rig;
-    let arm = rig.index("LeftArm").unwrap();
-    let (head, tail) = (rig.bones[arm].head, rig.bones[arm].tail);
-    let swing = Quat::from_rotation_arc((tail - head).normalize(), dir.normalize());
     let mut world = vec![Quat::IDENTITY; rig.len()];
-    let mut below = vec![false; rig.len()];
-    for (b, bone) in rig.bones.iter().enumerate() {
-        below[b] = b == arm || bone.parent.is_some_and(|p| below[p]);
-        if below[b] {
-            world[b] = swing;
-        }
-    }
+    rig.swing_limb(&mut world, rig.index("LeftArm").unwrap(), dir);
     Pose::from_world_rotations(rig, &world, Vec3::ZERO)
 }
 

@@ -100,15 +100,7 @@ fn arms_sunk_into_a_heavy_chest_are_cleared_before_draping() {
     let mut world = vec![Quat::IDENTITY; rig.len()];
     for (name, side) in [("LeftArm", -1.0f32), ("RightArm", 1.0)] {
         let arm = rig.index(name).unwrap();
-        let dir = (rig.bones[arm].tail - rig.bones[arm].head).normalize();
-        let swing = Quat::from_rotation_arc(dir, Vec3::new(side * 0.14, -1.0, 0.0).normalize());
-        let mut below = vec![false; rig.len()];
-        for (b, bone) in rig.bones.iter().enumerate() {
-            below[b] = b == arm || bone.parent.is_some_and(|p| below[p]);
-            if below[b] {
-                world[b] = swing;
-            }
-        }
+        rig.swing_limb(&mut world, arm, Vec3::new(side * 0.14, -1.0, 0.0));
     }
     let pose = Pose::from_world_rotations(rig, &world, Vec3::ZERO);
     let opts = DrapeOptions {
