@@ -3,7 +3,7 @@
 //! of vertices inside the body), Figure 4's precision curves (PNG), and Table 2's timing
 //! (network per drape, DQS warp, simulator). Markdown and JSON.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -171,7 +171,14 @@ pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
     let body_rest = body_model.shape(&Phenotype::default())?;
     let mut rows: Vec<Row> = Vec::new();
     let mut timings: Vec<Timing> = Vec::new();
-    let mut dqs_done: BTreeMap<String, ()> = BTreeMap::new();
+    let mut dqs_done: BTreeSet<String> = BTreeSet::new();
+    // Simulator wall time of each stored sample, by index.
+    let sim_times: HashMap<u64, f64> = data
+        .manifest()
+        .samples
+        .iter()
+        .filter_map(|e| Some((e.record.index, e.timing.as_ref()?.drape_s)))
+        .collect();
     for path in &args.models {
         let draper =
             Draper::load(path, &device).with_context(|| format!("loading {}", path.display()))?;
@@ -209,22 +216,14 @@ pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
                 let start = Instant::now();
                 garment::warp::warp(&template, &body_rest, &pose, Skinning::Dqs)?;
                 dqs_ms.push(start.elapsed().as_secs_f64() * 1e3);
-                if let Some(t) = data
-                    .manifest()
-                    .samples
-                    .iter()
-                    .find(|e| e.record.index == s.record.index)
-                    .and_then(|e| e.timing.as_ref())
-                {
-                    sim_s.push(t.drape_s);
-                }
+                sim_s.extend(sim_times.get(&s.record.index));
                 let body = Bvh::from_mesh(&TriMesh::new(a.body.clone(), body_faces.clone()))?;
                 net.add(&a.draped, &pred, faces, &body)?;
                 dqs.add(&a.draped, &a.warped, faces, &body)?;
             }
         }
         rows.push(net.row(&garment, &method));
-        if dqs_done.insert(garment.clone(), ()).is_none() {
+        if dqs_done.insert(garment.clone()) {
             rows.push(dqs.row(&garment, "DQS"));
         }
         timings.push(Timing {
