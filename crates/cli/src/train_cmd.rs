@@ -57,6 +57,13 @@ pub struct TrainArgs {
     /// See --no-pen.
     #[arg(long)]
     pub no_bend: bool,
+    /// Length unit of the loss terms (the paper's weights balance them in centimetres).
+    #[arg(long, value_enum, default_value_t = LossUnit::Cm)]
+    pub loss_unit: LossUnit,
+    /// The body stream sees every N-th body vertex (farthest-point order; 4 gives 3345 of
+    /// the 13380, 2 the paper's ~6.9k). A new run only: a resumed run keeps its network.
+    #[arg(long, value_name = "N")]
+    pub body_subsample: Option<usize>,
     /// Seed of the per-epoch shuffle.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -84,6 +91,15 @@ impl From<VariantArg> for Variant {
             VariantArg::Naive => Variant::Naive,
         }
     }
+}
+
+/// Length unit of the loss on the command line.
+#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LossUnit {
+    /// Centimetres (L_vertex in cm^2).
+    Cm,
+    /// Metres.
+    M,
 }
 
 /// A dataset's samples of one garment and split, as the network's training samples.
@@ -177,8 +193,12 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
         }
         let template = train.template()?;
         let garment_file = template.to_bytes(&args.data)?;
+        let mut config = GarNetConfig::new(variant);
+        if let Some(n) = args.body_subsample {
+            config.body_subsample = n;
+        }
         let setup = ModelSetup::new(
-            GarNetConfig::new(variant),
+            config,
             template.mesh.clone(),
             &train.reference_body()?,
         )?
@@ -256,6 +276,10 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
 /// The paper's loss weights, with the terms `args` turned off set to zero.
 fn loss_config(args: &TrainArgs) -> LossConfig {
     let mut cfg = LossConfig::new();
+    cfg.units_per_metre = match args.loss_unit {
+        LossUnit::Cm => 100.0,
+        LossUnit::M => 1.0,
+    };
     if args.no_pen {
         cfg.pen = 0.0;
     }

@@ -7,6 +7,7 @@ use burn::prelude::*;
 use glam::Vec3;
 
 use crate::error::{check_count, check_finite, ModelError, Result};
+use crate::frame::CanonicalFrame;
 use crate::local::{BodySampling, LocalIndices};
 use crate::tensors::{points_tensor, vec_tensor};
 use crate::topology::GarmentTopology;
@@ -104,9 +105,21 @@ pub struct InputSpec {
     /// GarNet-Local: (stream points averaged per kept point (16), kept points max-pooled per
     /// garment vertex (15)); `None` for the other variants.
     pub local: Option<(usize, usize)>,
+    /// The template's rest vertices `[N]` (metres) that each sample's canonical frame is
+    /// fitted to (see [`crate::frame`]); `None` keeps world coordinates.
+    pub canonical_rest: Option<Vec<Vec3>>,
 }
 
 impl InputSpec {
+    /// The canonical frame of a sample with warped garment `warped` `[N]` (the identity
+    /// without [`InputSpec::canonical_rest`]).
+    pub fn frame(&self, warped: &[Vec3]) -> CanonicalFrame {
+        match &self.canonical_rest {
+            Some(rest) => CanonicalFrame::fit(rest, warped),
+            None => CanonicalFrame::fit(&[], &[]),
+        }
+    }
+
     /// The network inputs of B samples: stream points `[B][P]` of `bodies` `[B][V]`, and the
     /// local tables of them and `warped` `[B][N]` when the spec has them.
     pub fn inputs(
@@ -161,8 +174,10 @@ pub struct Batch {
     /// Per-sample k-d trees over the body vertices (the penetration loss's nearest-vertex
     /// search), built with the batch when it has targets.
     pub(crate) body_index: Vec<Arc<geom::KnnIndex>>,
-    /// Targets on the CPU `[B][N]` (the penetration mask and the metrics).
+    /// Targets on the CPU `[B][N]`, canonical frame (the penetration mask and the metrics).
     pub(crate) target_points: Option<Vec<Vec<Vec3>>>,
+    /// Each sample's canonical frame: every tensor of the batch is in it.
+    pub frames: Vec<CanonicalFrame>,
 }
 
 impl std::fmt::Debug for Batch {
@@ -210,15 +225,33 @@ impl Batch {
                 check_finite("target garment G", t)?;
             }
         }
-        let bodies: Vec<&[Vec3]> = samples.iter().map(|s| s.body.as_slice()).collect();
-        let normals: Vec<&[Vec3]> = samples.iter().map(|s| s.body_normals.as_slice()).collect();
-        let warped: Vec<&[Vec3]> = samples.iter().map(|s| s.warped.as_slice()).collect();
+        let frames: Vec<CanonicalFrame> = samples.iter().map(|s| spec.frame(&s.warped)).collect();
+        let moved = |points: fn(&Sample) -> &[Vec3]| -> Vec<Vec<Vec3>> {
+            samples
+                .iter()
+                .zip(&frames)
+                .map(|(s, f)| f.points_to_canonical(points(s)))
+                .collect()
+        };
+        let bodies = moved(|s| &s.body);
+        let warped = moved(|s| &s.warped);
+        let targets = moved(|s| s.target.as_deref().unwrap_or(&[]));
+        let normals: Vec<Vec<Vec3>> = samples
+            .iter()
+            .zip(&frames)
+            .map(|(s, f)| {
+                s.body_normals
+                    .iter()
+                    .map(|&d| f.direction_to_canonical(d))
+                    .collect()
+            })
+            .collect();
+        let bodies: Vec<&[Vec3]> = bodies.iter().map(Vec::as_slice).collect();
+        let normals: Vec<&[Vec3]> = normals.iter().map(Vec::as_slice).collect();
+        let warped: Vec<&[Vec3]> = warped.iter().map(Vec::as_slice).collect();
         let (body_stream, local) = spec.inputs(&bodies, &warped, device)?;
         let (target, target_points, body_index) = if with_target {
-            let targets: Vec<&[Vec3]> = samples
-                .iter()
-                .map(|s| s.target.as_deref().unwrap_or(&[]))
-                .collect();
+            let targets: Vec<&[Vec3]> = targets.iter().map(Vec::as_slice).collect();
             let index = bodies
                 .iter()
                 .map(|b| geom::KnnIndex::new(b).map(Arc::new))
@@ -248,6 +281,7 @@ impl Batch {
             local,
             body_index,
             target_points,
+            frames,
         })
     }
 

@@ -93,6 +93,7 @@ impl ModelSetup {
                 .variant
                 .has_local()
                 .then_some((self.config.pool_neighbours, self.config.local_neighbours)),
+            canonical_rest: Some(self.template.vertices.clone()),
         }
     }
 

@@ -5,8 +5,8 @@
 //! always compiled in; `cuda` and `wgpu` behind the cargo features of the same names).
 //! Training uses `device.autodiff()`; inference a plain device.
 //!
-//! Units: metres. Shapes: `B` samples, `V` body vertices (13380), `P` body points the body
-//! stream sees (a fixed subset, 6690 by default), `N` garment vertices, `F` garment faces, `K`
+//! Units: metres (the loss terms: centimetres, see [`LossConfig::units_per_metre`]). Shapes: `B` samples, `V` body vertices (13380), `P` body points the body
+//! stream sees (a fixed subset, 3345 by default), `N` garment vertices, `F` garment faces, `K`
 //! neighbourhood width; point tensors are `[B,V,3]`, `[B,P,3]`, `[B,N,3]`.
 //!
 //! The flow, as a CLI uses it:
@@ -42,6 +42,7 @@ pub mod config;
 pub mod drape;
 pub mod error;
 pub mod feast;
+pub mod frame;
 pub mod fusion;
 pub mod garment_stream;
 pub mod garnet;
@@ -62,6 +63,7 @@ pub use batch::{Batch, BodyTopology, InputSpec, Sample};
 pub use checkpoint::{load_checkpoint, save_checkpoint, Checkpoint, ModelSetup, TrainState};
 pub use config::{GarNetConfig, Variant};
 pub use drape::Draper;
+pub use frame::CanonicalFrame;
 pub use error::{ModelError, Result};
 pub use garnet::GarNet;
 pub use init::LEAKY_SLOPE;

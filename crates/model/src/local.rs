@@ -7,8 +7,8 @@
 //! by farthest-point sampling on a reference body and stored in the checkpoint: it stays
 //! evenly spread over the surface in every shape and pose and costs nothing per sample.
 //!
-//! - The body stream sees the first `ceil(V / body_subsample)` vertices of that list (6690 of
-//!   13380 by default, the paper's point count).
+//! - The body stream sees the first `ceil(V / body_subsample)` vertices of that list (3345 of
+//!   13380 by default; 6690 with `body_subsample = 2`, about the paper's point count).
 //! - GarNet-Local keeps the first `ceil(P / body_downsample)` of those stream points (10x, as in
 //!   the paper): a prefix of a farthest-point order is itself a farthest-point sample. Per
 //!   sample, each kept point averages the features of its `pool_k` (16) nearest stream points

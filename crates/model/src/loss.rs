@@ -4,13 +4,14 @@
 //! L = w_vertex L_vertex + w_pen L_pen + w_norm L_norm + w_bend L_bend   (1, 1.0, 0.3, 0.5)
 //! ```
 //!
-//! - `L_vertex = 1/N sum_i |G^G_i - G^P_i|^2` (square metres);
+//! - `L_vertex = 1/N sum_i |G^G_i - G^P_i|^2` (square centimetres by default, see
+//!   [`LossConfig::units_per_metre`]; lengths below likewise);
 //! - `L_pen = 1/N sum_j 1{|G^P_j - G^G_j| < d_tol} ReLU(-n_i . (G^P_j - (B_i + 0.2 e n_i)))`
-//!   (metres), with i the body vertex nearest to G^P_j (found on the CPU at every step),
-//!   n_i its unit normal, e the body's mean edge length and d_tol = 0.05 m;
+//!   (centimetres), with i the body vertex nearest to G^P_j (found on the CPU at every step),
+//!   n_i its unit normal, e the body's mean edge length and d_tol = 0.05 m (5 cm);
 //! - `L_norm = 1/F sum_f (1 - F^G_f . F^P_f)^2` over unit face normals (no unit);
 //! - `L_bend = 1/|N2| sum_{i,k} | |G^P_i - G^P_k| - |G^G_i - G^G_k| |` over vertex pairs two
-//!   edges apart (metres).
+//!   edges apart (centimetres).
 //!
 //! Every term is averaged over the batch too. Each weight can be set to 0 for ablations; the
 //! terms are computed and reported either way.
@@ -51,6 +52,13 @@ pub struct LossConfig {
     /// mean edge length (0.2).
     #[config(default = 0.2)]
     pub pen_push: f64,
+    /// Length unit of the loss terms, in units per metre: 100 measures L_vertex in cm^2 and
+    /// L_pen, L_bend in cm (as the paper reports its errors); 1 in metres. The paper's weights
+    /// balance the terms only in centimetres: in metres the unit-free L_norm and the linear
+    /// L_pen, L_bend outweigh L_vertex's gradient 10-100 times and the network barely learns
+    /// the drape (see docs/model.md).
+    #[config(default = 100.0)]
+    pub units_per_metre: f64,
 }
 
 /// Loss values of one step or averaged over many (f32; the units of each term).
@@ -58,13 +66,13 @@ pub struct LossConfig {
 pub struct LossTerms {
     /// Weighted sum.
     pub total: f32,
-    /// L_vertex, square metres.
+    /// L_vertex, square loss units (cm^2 by default, see [`LossConfig::units_per_metre`]).
     pub vertex: f32,
-    /// L_pen, metres.
+    /// L_pen, loss units (cm).
     pub pen: f32,
     /// L_norm, no unit.
     pub norm: f32,
-    /// L_bend, metres.
+    /// L_bend, loss units (cm).
     pub bend: f32,
 }
 
@@ -263,6 +271,10 @@ pub fn garnet_loss(
     );
     let norm = normal_loss(pred.clone(), target.clone(), &topo.faces);
     let bend = bending_loss(pred, target, &topo.bend_pairs);
+    let unit = cfg.units_per_metre;
+    let vertex = vertex * (unit * unit);
+    let pen = pen * unit;
+    let bend = bend * unit;
     let weighted = [
         (cfg.vertex, &vertex),
         (cfg.pen, &pen),
@@ -338,6 +350,7 @@ mod tests {
                 n_centres: 1,
             },
             local: None,
+            canonical_rest: None,
         };
         let b = Batch::new(&[sample], &topo, &spec, device).unwrap();
         (b, topo.to_device(device))
@@ -372,8 +385,8 @@ mod tests {
         );
         // Vertices 0 and 1 sit at z = 0, 1 cm under their pushed body points (z = 0.01):
         // 0.01 each; vertices 2 and 3 are > d_tol from their targets and do not count.
-        let cfg = LossConfig::new();
-        let all = garnet_loss(pred, &b, &topo, &cfg)
+        let cfg = LossConfig::new().with_units_per_metre(1.0);
+        let all = garnet_loss(pred.clone(), &b, &topo, &cfg)
             .unwrap()
             .values()
             .unwrap();
@@ -382,13 +395,22 @@ mod tests {
         close(all.norm, tilt);
         close(all.bend, bend);
         close(all.total, 0.3125 + 0.005 + 0.3 * tilt + 0.5 * bend);
+        // The default unit, centimetres: lengths x100, L_vertex x1e4, L_norm unchanged.
+        let cm = garnet_loss(pred, &b, &topo, &LossConfig::new())
+            .unwrap()
+            .values()
+            .unwrap();
+        let rel = |a: f32, b: f64| ((a as f64 - b) / b).abs() < 1e-5;
+        assert!(rel(cm.vertex, 3125.0) && rel(cm.pen, 0.5), "{cm:?}");
+        assert!(rel(cm.bend, 100.0 * bend) && rel(cm.norm, tilt), "{cm:?}");
+        assert!(rel(cm.total, 3125.0 + 0.5 + 0.3 * tilt + 50.0 * bend), "{cm:?}");
     }
 
     #[test]
     fn penetration_counts_only_close_vertices_on_the_wrong_side() {
         let device = Device::flex();
         let (b, topo) = batch(&device);
-        let cfg = LossConfig::new();
+        let cfg = LossConfig::new().with_units_per_metre(1.0);
         // Vertex 0 3 cm up (within d_tol, 2 cm outside its pushed body point), vertices 2 and
         // 3 2 cm up (1 cm outside): no penalty; vertex 1 stays 1 cm inside: 0.01 / 4.
         let mut p = square().vertices;
@@ -417,6 +439,7 @@ mod tests {
         let (b, topo) = batch(&device);
         let pred = points_tensor(&[&prediction()], &device);
         let cfg = LossConfig::new()
+            .with_units_per_metre(1.0)
             .with_norm(0.0)
             .with_bend(0.0)
             .with_pen(0.0);
@@ -434,6 +457,10 @@ mod tests {
             .validate()
             .is_err());
         assert!(LossConfig::new().with_d_tol(-1.0).validate().is_err());
+        assert!(LossConfig::new()
+            .with_units_per_metre(0.0)
+            .validate()
+            .is_err());
     }
 
     /// Central differences of the full loss against its autodiff gradient, for every
@@ -486,8 +513,9 @@ mod tests {
                 n_centres: 1,
             },
             local: None,
+            canonical_rest: None,
         };
-        let cfg = LossConfig::new();
+        let cfg = LossConfig::new().with_units_per_metre(1.0);
         let loss_at = |p: &[Vec3]| -> f64 {
             let b = Batch::new(std::slice::from_ref(&sample), &topo, &spec, &plain).unwrap();
             let tt = topo.to_device(&plain);

@@ -36,6 +36,12 @@ impl LossConfig {
                 "loss weights and constants must be finite and >= 0: {self:?}"
             )));
         }
+        if !(self.units_per_metre.is_finite() && self.units_per_metre > 0.0) {
+            return Err(ModelError::InvalidInput(format!(
+                "the loss unit must be a positive number of units per metre, got {}",
+                self.units_per_metre
+            )));
+        }
         if self.vertex + self.pen + self.norm + self.bend == 0.0 {
             return Err(ModelError::InvalidInput("every loss weight is 0".into()));
         }

@@ -146,6 +146,35 @@ fn drape_refuses_wrong_vertex_counts_and_non_finite_input() {
     );
 }
 
+/// Draping is unchanged by a turn about gravity and a horizontal move: the network works in
+/// the canonical frame fitted to M, so a turned and moved input gives the same drape, turned
+/// and moved (up to rounding), for every variant.
+#[test]
+fn drape_follows_a_turn_about_gravity_and_a_move() {
+    let device = Device::flex();
+    for variant in Variant::ALL {
+        let s = setup(variant, 60);
+        let model = s.config.init(&device).unwrap();
+        let draper = Draper::new(model, s.clone(), &device).unwrap();
+        let sample = &samples(&s, 2)[1];
+        let plain = draper.drape(&sample.body, &sample.warped).unwrap();
+        let frame = CanonicalFrame {
+            rotation: glam::Quat::from_rotation_y(2.3),
+            offset: Vec3::new(1.5, 0.0, -0.8),
+        };
+        let turn = |pts: &[Vec3]| -> Vec<Vec3> { pts.iter().map(|&p| frame.to_world(p)).collect() };
+        let turned = draper
+            .drape(&turn(&sample.body), &turn(&sample.warped))
+            .unwrap();
+        let worst = turn(&plain)
+            .iter()
+            .zip(&turned)
+            .map(|(a, b)| a.distance(*b))
+            .fold(0.0f32, f32::max);
+        assert!(worst < 1e-4, "{variant:?}: turned drape differs by {worst} m");
+    }
+}
+
 #[test]
 fn batch_refuses_mismatched_samples() {
     let device = Device::flex();
