@@ -55,28 +55,6 @@ impl From<SkinningArg> for Skinning {
     }
 }
 
-impl BodyArgs {
-    /// The main job on the embedded defaults: a random realistic adult in a procedural
-    /// pose, written to `out/body.glb` and `out/body.png`.
-    pub fn main_job() -> Self {
-        Self {
-            shape: ShapeArgs {
-                random_shape: Some(1),
-                ..ShapeArgs::defaults()
-            },
-            pose: PoseArgs {
-                pose_procedural: Some(1),
-                ..PoseArgs::default()
-            },
-            skinning: SkinningArg::Dqs,
-            out: "out/body.glb".into(),
-            png: Some("out/body.png".into()),
-            sheet: None,
-            mocap: "../shared/mocap/cmu".into(),
-        }
-    }
-}
-
 pub fn run(args: &BodyArgs) -> anyhow::Result<()> {
     let model = BodyModel::load()?;
     if let Some(sheet) = &args.sheet {

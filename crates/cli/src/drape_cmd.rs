@@ -1,6 +1,8 @@
 //! `garnet drape`: a body in, draped garments out, with trained GarNet models. Each model
 //! file carries its garment template, so nothing else is needed: the template is warped
 //! onto the posed body by DQS (the network's input M) and the network predicts the drape.
+//! With no command, garnet drapes the three shipped models (`models/`) on a random body in a
+//! random pose ([`DrapeArgs::main_job`]).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -47,6 +49,57 @@ pub struct DrapeArgs {
     /// Where the networks run.
     #[arg(long, value_enum, default_value_t = DeviceArg::Cpu)]
     pub device: DeviceArg,
+}
+
+/// The shipped GarNet-Local models (in [`shipped_models_dir`]): T-shirt, sweater, jeans.
+pub const SHIPPED_MODELS: [&str; 3] = [
+    "tshirt-local.garnet",
+    "sweater-local.garnet",
+    "jeans-local.garnet",
+];
+
+/// Where the shipped models are: `models/` in the working directory when it holds them,
+/// else the `models/` folder of the repository this binary was built from.
+pub fn shipped_models_dir() -> PathBuf {
+    let local = PathBuf::from("models");
+    if local.join(SHIPPED_MODELS[0]).is_file() {
+        return local;
+    }
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models")
+}
+
+impl DrapeArgs {
+    /// The main job: the three shipped models on a random realistic adult (shape seed 1) in
+    /// a procedural pose (seed 1), written to `out/draped-GARMENT.glb`, `out/body.glb` and a
+    /// picture `out/drape.png`. Fails, naming the folder, when the models are missing.
+    pub fn main_job() -> anyhow::Result<Self> {
+        let dir = shipped_models_dir();
+        let models: Vec<PathBuf> = SHIPPED_MODELS.iter().map(|m| dir.join(m)).collect();
+        if let Some(missing) = models.iter().find(|m| !m.is_file()) {
+            return Err(anyhow!(
+                "{}: shipped model missing (the main job drapes {}; train and export them as \
+                 README \"GarNet\" shows)",
+                missing.display(),
+                SHIPPED_MODELS.join(", ")
+            ));
+        }
+        Ok(Self {
+            models,
+            shape: ShapeArgs {
+                random_shape: Some(1),
+                ..ShapeArgs::defaults()
+            },
+            pose: PoseArgs {
+                pose_procedural: Some(1),
+                ..PoseArgs::default()
+            },
+            keep_pose: false,
+            out: "out/draped.glb".into(),
+            body_out: Some("out/body.glb".into()),
+            png: Some("out/drape.png".into()),
+            device: DeviceArg::Cpu,
+        })
+    }
 }
 
 /// The garment template a checkpoint carries.

@@ -162,31 +162,80 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// Runs `garnet eval`.
-pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
-    let device = args.device.device()?;
-    let data = Dataset::open(&args.data)?;
-    let body_faces = data.body_faces()?;
-    let body_model = BodyModel::load()?;
-    let body_rest = body_model.shape(&Phenotype::default())?;
-    let mut rows: Vec<Row> = Vec::new();
-    let mut timings: Vec<Timing> = Vec::new();
-    let mut dqs_done: BTreeSet<String> = BTreeSet::new();
-    // Simulator wall time of each stored sample, by index.
-    let sim_times: HashMap<u64, f64> = data
-        .manifest()
-        .samples
-        .iter()
-        .filter_map(|e| Some((e.record.index, e.timing.as_ref()?.drape_s)))
-        .collect();
-    for path in &args.models {
+/// What evaluating one model on a split gives: its Table 1 row, the DQS row of the same
+/// samples, and its Table 2 row.
+pub struct ModelEvaluation {
+    /// The dataset garment the model drapes.
+    pub garment: String,
+    net: Row,
+    dqs: Row,
+    timing: Timing,
+}
+
+impl ModelEvaluation {
+    /// (samples, E_dist cm, E_norm degrees, share of vertices inside the body) of the
+    /// network, then of the DQS warp.
+    pub fn summary(&self) -> [(usize, f32, f32, f32); 2] {
+        [&self.net, &self.dqs].map(|r| (r.samples, r.e_dist_cm, r.e_norm_deg, r.inside_share))
+    }
+
+    /// Median network time per drape (ms) and median simulator time of the same samples (s).
+    pub fn times(&self) -> (f64, Option<f64>) {
+        (self.timing.network_ms, self.timing.simulator_s)
+    }
+}
+
+/// A dataset opened for evaluation: the body faces, the template body and the simulator
+/// time of each stored sample.
+pub struct EvalData {
+    data: Dataset,
+    body_faces: Vec<[u32; 3]>,
+    body_rest: body::ShapedBody,
+    sim_times: HashMap<u64, f64>,
+}
+
+impl EvalData {
+    /// Opens the dataset at `dir` (and loads the body model for the DQS timing).
+    pub fn open(dir: &Path) -> anyhow::Result<Self> {
+        let data = Dataset::open(dir)?;
+        let body_faces = data.body_faces()?;
+        let body_rest = BodyModel::load()?.shape(&Phenotype::default())?;
+        let sim_times = data
+            .manifest()
+            .samples
+            .iter()
+            .filter_map(|e| Some((e.record.index, e.timing.as_ref()?.drape_s)))
+            .collect();
+        Ok(Self {
+            data,
+            body_faces,
+            body_rest,
+            sim_times,
+        })
+    }
+
+    /// The dataset.
+    pub fn dataset(&self) -> &Dataset {
+        &self.data
+    }
+
+    /// Evaluates the model at `path` on `split` (at most `max_samples` samples of its
+    /// garment).
+    pub fn evaluate(
+        &self,
+        path: &Path,
+        split: &str,
+        max_samples: Option<usize>,
+        device: &burn::prelude::Device,
+    ) -> anyhow::Result<ModelEvaluation> {
+        let data = &self.data;
         let draper =
-            Draper::load(path, &device).with_context(|| format!("loading {}", path.display()))?;
+            Draper::load(path, device).with_context(|| format!("loading {}", path.display()))?;
         let template = checkpoint_template(&draper, path)?;
         let faces = &template.mesh.faces;
-        let garment = matching_garment(&data, &args.split, &template.mesh)?;
-        let mut indices = data.select(Some(&args.split), Some(&garment))?;
-        if let Some(n) = args.max_samples {
+        let garment = matching_garment(data, split, &template.mesh)?;
+        let mut indices = data.select(Some(split), Some(&garment))?;
+        if let Some(n) = max_samples {
             indices.truncate(n);
         }
         let method = format!("GarNet-{}", draper.setup().config.variant.name());
@@ -202,7 +251,7 @@ pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
             order: Order::InOrder,
             drop_last: false,
         };
-        for batch in Batches::new(&data, &indices, opts) {
+        for batch in Batches::new(data, &indices, opts) {
             for s in batch? {
                 let a = &s.arrays;
                 let start = Instant::now();
@@ -214,26 +263,44 @@ pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
                     rotations: a.rotations.clone(),
                 };
                 let start = Instant::now();
-                garment::warp::warp(&template, &body_rest, &pose, Skinning::Dqs)?;
+                garment::warp::warp(&template, &self.body_rest, &pose, Skinning::Dqs)?;
                 dqs_ms.push(start.elapsed().as_secs_f64() * 1e3);
-                sim_s.extend(sim_times.get(&s.record.index));
-                let body = Bvh::from_mesh(&TriMesh::new(a.body.clone(), body_faces.clone()))?;
+                sim_s.extend(self.sim_times.get(&s.record.index));
+                let body = Bvh::from_mesh(&TriMesh::new(a.body.clone(), self.body_faces.clone()))?;
                 net.add(&a.draped, &pred, faces, &body)?;
                 dqs.add(&a.draped, &a.warped, faces, &body)?;
             }
         }
-        rows.push(net.row(&garment, &method));
-        if dqs_done.insert(garment.clone()) {
-            rows.push(dqs.row(&garment, "DQS"));
+        Ok(ModelEvaluation {
+            net: net.row(&garment, &method),
+            dqs: dqs.row(&garment, "DQS"),
+            timing: Timing {
+                garment: garment.clone(),
+                method,
+                vertices: template.mesh.vertices.len(),
+                network_ms: median(net_ms),
+                dqs_ms: median(dqs_ms),
+                simulator_s: (!sim_s.is_empty()).then(|| median(sim_s)),
+            },
+            garment,
+        })
+    }
+}
+
+/// Runs `garnet eval`.
+pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
+    let device = args.device.device()?;
+    let data = EvalData::open(&args.data)?;
+    let mut rows: Vec<Row> = Vec::new();
+    let mut timings: Vec<Timing> = Vec::new();
+    let mut dqs_done: BTreeSet<String> = BTreeSet::new();
+    for path in &args.models {
+        let e = data.evaluate(path, &args.split, args.max_samples, &device)?;
+        rows.push(e.net);
+        if dqs_done.insert(e.garment) {
+            rows.push(e.dqs);
         }
-        timings.push(Timing {
-            garment: garment.clone(),
-            method,
-            vertices: template.mesh.vertices.len(),
-            network_ms: median(net_ms),
-            dqs_ms: median(dqs_ms),
-            simulator_s: (!sim_s.is_empty()).then(|| median(sim_s)),
-        });
+        timings.push(e.timing);
     }
     write_reports(&args.out, &args.split, &rows, &timings)
 }

@@ -8,6 +8,7 @@ mod dataset_cmd;
 mod dataset_show;
 mod drape_cmd;
 mod eval_cmd;
+mod export_cmd;
 mod garment_cmd;
 mod garment_sheet;
 mod model_device;
@@ -23,8 +24,9 @@ use clap::{Parser, Subcommand};
 
 /// garnet: fast, accurate 3D cloth draping (GarNet, ICCV 2019) in one binary.
 ///
-/// With no command, runs the main job on the embedded defaults: a random realistic adult
-/// in a procedural pose, written to out/body.glb and out/body.png.
+/// With no command, runs the main job on the embedded defaults: the three shipped GarNet
+/// models (models/) drape a T-shirt, a sweater and jeans on a random realistic adult in a
+/// procedural pose, written to out/draped-*.glb, out/body.glb and out/drape.png.
 #[derive(Parser, Debug)]
 #[command(name = "garnet", version, about, long_about)]
 struct Cli {
@@ -56,6 +58,8 @@ enum Cmd {
     Eval(eval_cmd::EvalArgs),
     /// Train a GarNet network for one garment of a dataset.
     Train(train_cmd::TrainArgs),
+    /// Export a training checkpoint as a model to ship, with its model card.
+    Export(export_cmd::ExportArgs),
     /// Benchmarks measured in one run, reported with ratios to a reference.
     #[command(subcommand)]
     Bench(bench_cmd::BenchCmd),
@@ -64,7 +68,7 @@ enum Cmd {
 fn main() {
     let cli = Cli::parse();
     let result = match &cli.cmd {
-        None => body_cmd::run(&body_cmd::BodyArgs::main_job()),
+        None => drape_cmd::DrapeArgs::main_job().and_then(|a| drape_cmd::run(&a)),
         Some(Cmd::Assets(c)) => assets_cmd::run(c),
         Some(Cmd::Body(a)) => body_cmd::run(a),
         Some(Cmd::Garment(c)) => garment_cmd::run(c),
@@ -73,6 +77,7 @@ fn main() {
         Some(Cmd::Dataset(c)) => dataset_cmd::run(c),
         Some(Cmd::Drape(a)) => drape_cmd::run(a),
         Some(Cmd::Eval(a)) => eval_cmd::run(a),
+        Some(Cmd::Export(a)) => export_cmd::run(a),
         Some(Cmd::Train(a)) => train_cmd::run(a),
         Some(Cmd::Bench(c)) => bench_cmd::run(c),
     };

@@ -197,14 +197,16 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
         if let Some(n) = args.body_subsample {
             config.body_subsample = n;
         }
-        let setup = ModelSetup::new(
-            config,
-            template.mesh.clone(),
-            &train.reference_body()?,
-        )?
-        .with_garment_file(garment_file);
+        let setup = ModelSetup::new(config, template.mesh.clone(), &train.reference_body()?)?
+            .with_garment_file(garment_file);
         Trainer::new(setup, loss_config(args), args.lr, &device)?
     };
+    trainer.set_command(
+        std::iter::once("garnet".to_string())
+            .chain(std::env::args().skip(1))
+            .collect::<Vec<_>>()
+            .join(" "),
+    );
     let params = trainer.model().num_params();
     eprintln!(
         "training GarNet-{} ({params} parameters) on {} '{}' samples ({} validation), \

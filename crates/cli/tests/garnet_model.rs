@@ -147,13 +147,56 @@ fn train_resume_eval_and_drape() {
         assert!(eval.join(f).is_file(), "{f}");
     }
 
-    // Draping needs only the model file.
+    // Export: the network without the optimiser state, and its model card.
+    let shipped = tmp.path().join("models").join("tshirt-local.garnet");
+    ok(&[
+        "export",
+        "--model",
+        s(&best),
+        "--data",
+        s(data),
+        "--out",
+        s(&shipped),
+    ]);
+    let size = |p: &Path| std::fs::metadata(p).unwrap().len();
+    assert!(
+        size(&shipped) * 2 < size(&best),
+        "{} vs {} bytes",
+        size(&shipped),
+        size(&best)
+    );
+    let card = std::fs::read_to_string(shipped.with_extension("md")).unwrap();
+    for needle in [
+        "GarNet-local for the tshirt",
+        "garnet train --data",
+        "--resume",
+        "| GarNet-local |",
+        "| DQS warp (the input M) |",
+        "3 epochs",
+    ] {
+        assert!(card.contains(needle), "{needle} missing:\n{card}");
+    }
+    let err = fails(&[
+        "export",
+        "--model",
+        s(&best),
+        "--data",
+        s(data),
+        "--out",
+        s(&tmp.path().join("model.bin")),
+    ]);
+    assert!(
+        err.contains("model.bin") && err.contains(".garnet"),
+        "{err}"
+    );
+
+    // Draping needs only the (exported) model file.
     let out = tmp.path().join("draped.obj");
     let png = tmp.path().join("draped.png");
     let log = ok(&[
         "drape",
         "--model",
-        s(&best),
+        s(&shipped),
         "--random-shape",
         "2",
         "--pose-procedural",
@@ -227,5 +270,26 @@ fn bench_model_reports_every_variant_against_the_dqs_warp() {
             rows, 2,
             "{variant}: a drape row and a training-step row\n{out}"
         );
+    }
+}
+
+/// The main job (no command, run from any folder): the three shipped models drape a random
+/// body in a random pose; meshes and a picture land in `out/` of the working directory.
+#[test]
+fn main_job_drapes_the_three_shipped_models() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_garnet"))
+        .current_dir(tmp.path())
+        .output()
+        .unwrap();
+    let log = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "main job failed:\n{log}");
+    for garment in ["tshirt", "sweater", "jeans"] {
+        assert!(log.contains(&format!("{garment} (")), "{garment}:\n{log}");
+        let mesh = tmp.path().join(format!("out/draped-{garment}.glb"));
+        assert!(geom::io::read_mesh(&mesh).unwrap().vertices.len() > 100);
+    }
+    for f in ["out/body.glb", "out/drape.png"] {
+        assert!(tmp.path().join(f).is_file(), "{f}");
     }
 }

@@ -53,6 +53,9 @@ pub struct ModelSetup {
     /// The garment template file (`.garment` bytes: weights, rig, template body) the
     /// network's input M is warped with, so a checkpoint alone can drape; opaque here.
     pub garment_file: Option<Vec<u8>>,
+    /// Whether the network works in each sample's canonical frame (see [`crate::frame`]);
+    /// true for every new setup, false for checkpoints written before the frame existed.
+    pub canonical_frame: bool,
 }
 
 impl ModelSetup {
@@ -75,6 +78,7 @@ impl ModelSetup {
             template,
             body_sampling,
             garment_file: None,
+            canonical_frame: true,
         })
     }
 
@@ -93,7 +97,7 @@ impl ModelSetup {
                 .variant
                 .has_local()
                 .then_some((self.config.pool_neighbours, self.config.local_neighbours)),
-            canonical_rest: Some(self.template.vertices.clone()),
+            canonical_rest: self.canonical_frame.then(|| self.template.vertices.clone()),
         }
     }
 
@@ -131,6 +135,9 @@ pub struct TrainState {
     pub lr: f64,
     /// Best validation E_dist so far, centimetres (`None` before the first validation).
     pub best_e_dist_cm: Option<f32>,
+    /// The command line of the latest training run (for model cards), when it was given.
+    #[serde(default)]
+    pub command: Option<String>,
 }
 
 /// A checkpoint read from disk; [`Checkpoint::model`] and [`Checkpoint::optimizer`] rebuild
@@ -237,6 +244,7 @@ pub fn save_checkpoint(
         ("state".into(), json(state)?),
         ("body.n_vertices".into(), s.n_body.to_string()),
         ("body.n_centres".into(), s.n_centres.to_string()),
+        ("canonical_frame".into(), setup.canonical_frame.to_string()),
     ]);
     let views = tensors
         .iter()
@@ -268,8 +276,15 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint> {
     };
     let config: GarNetConfig =
         serde_json::from_str(field("config")?).map_err(|e| bad(format!("metadata config: {e}")))?;
-    let loss: LossConfig =
+    let mut loss_json: serde_json::Value =
         serde_json::from_str(field("loss")?).map_err(|e| bad(format!("metadata loss: {e}")))?;
+    // Checkpoints written before the loss had a unit were trained in metres.
+    if let Some(obj) = loss_json.as_object_mut() {
+        obj.entry("units_per_metre")
+            .or_insert(serde_json::json!(1.0));
+    }
+    let loss: LossConfig =
+        serde_json::from_value(loss_json).map_err(|e| bad(format!("metadata loss: {e}")))?;
     let state: TrainState =
         serde_json::from_str(field("state")?).map_err(|e| bad(format!("metadata state: {e}")))?;
     let st = SafeTensors::deserialize(&bytes).map_err(|e| bad(e.to_string()))?;
@@ -330,6 +345,7 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint> {
         template,
         body_sampling,
         garment_file,
+        canonical_frame: meta.get("canonical_frame").is_some_and(|v| v == "true"),
     };
     setup.validate().map_err(|e| bad(e.to_string()))?;
     Ok(Checkpoint {

@@ -35,9 +35,9 @@ impl CanonicalFrame {
         }
         let n = rest.len() as f64;
         let centre = |pts: &[Vec3]| {
-            let (x, z) = pts
-                .iter()
-                .fold((0.0f64, 0.0f64), |(x, z), p| (x + p.x as f64, z + p.z as f64));
+            let (x, z) = pts.iter().fold((0.0f64, 0.0f64), |(x, z), p| {
+                (x + p.x as f64, z + p.z as f64)
+            });
             (x / n, z / n)
         };
         let (rx, rz) = centre(rest);

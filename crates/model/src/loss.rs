@@ -403,7 +403,10 @@ mod tests {
         let rel = |a: f32, b: f64| ((a as f64 - b) / b).abs() < 1e-5;
         assert!(rel(cm.vertex, 3125.0) && rel(cm.pen, 0.5), "{cm:?}");
         assert!(rel(cm.bend, 100.0 * bend) && rel(cm.norm, tilt), "{cm:?}");
-        assert!(rel(cm.total, 3125.0 + 0.5 + 0.3 * tilt + 50.0 * bend), "{cm:?}");
+        assert!(
+            rel(cm.total, 3125.0 + 0.5 + 0.3 * tilt + 50.0 * bend),
+            "{cm:?}"
+        );
     }
 
     #[test]

@@ -14,10 +14,11 @@ use crate::topology::TopologyTensors;
 /// The paper's learning rate for Adam.
 pub const PAPER_LEARNING_RATE: f64 = 1e-3;
 
-/// The paper's optimiser: Adam (beta 0.9, 0.999, epsilon 1e-5 as burn's default); the learning
-/// rate is given at each step.
+/// The paper's optimiser: PyTorch's Adam (beta 0.9, 0.999, epsilon 1e-8; burn's default
+/// epsilon is 1e-5, which damps the steps of parameters whose gradients are smaller than
+/// that); the learning rate is given at each step.
 pub fn adam() -> ModuleOptimizer {
-    AdamConfig::new().init()
+    AdamConfig::new().with_epsilon(1e-8).init()
 }
 
 impl LossConfig {

@@ -166,6 +166,11 @@ impl Trainer {
         &self.state
     }
 
+    /// Records the command line of this training run in the checkpoints it writes.
+    pub fn set_command(&mut self, command: String) {
+        self.state.command = Some(command);
+    }
+
     /// The learning rate.
     pub fn lr(&self) -> f64 {
         self.lr

@@ -171,7 +171,10 @@ fn drape_follows_a_turn_about_gravity_and_a_move() {
             .zip(&turned)
             .map(|(a, b)| a.distance(*b))
             .fold(0.0f32, f32::max);
-        assert!(worst < 1e-4, "{variant:?}: turned drape differs by {worst} m");
+        assert!(
+            worst < 1e-4,
+            "{variant:?}: turned drape differs by {worst} m"
+        );
     }
 }
 

@@ -1,0 +1,167 @@
+//! `garnet export`: a training checkpoint as a model to ship: the network with its garment
+//! template and body sampling, without the optimiser state (a third of the checkpoint's
+//! size), and a model card beside it (`NAME.md`): what the model drapes, how it was trained
+//! (dataset, command, progress, loss weights) and its test metrics against the DQS warp,
+//! measured by the same code as `garnet eval`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context};
+use burn::module::Module;
+use clap::Args;
+use model::{load_checkpoint, save_checkpoint, Checkpoint};
+
+use crate::eval_cmd::{EvalData, ModelEvaluation};
+use crate::model_device::DeviceArg;
+
+/// Arguments of `garnet export`.
+#[derive(Args, Debug, Clone)]
+pub struct ExportArgs {
+    /// Training checkpoint (`best.garnet` or `last.garnet` of `garnet train`).
+    #[arg(long, value_name = "CKPT")]
+    pub model: PathBuf,
+    /// The dataset the model was trained on (its test split gives the card's metrics).
+    #[arg(long, value_name = "DIR")]
+    pub data: PathBuf,
+    /// Split for the card's metrics.
+    #[arg(long, default_value = "test")]
+    pub split: String,
+    /// Evaluate at most this many samples.
+    #[arg(long, value_name = "N")]
+    pub max_samples: Option<usize>,
+    /// Model file to write (`.garnet`); the card goes beside it with the extension `.md`.
+    #[arg(long, value_name = "FILE.garnet")]
+    pub out: PathBuf,
+}
+
+/// Runs `garnet export`.
+pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
+    if args.out.extension().and_then(|e| e.to_str()) != Some("garnet") {
+        bail!("{}: the model file must end in .garnet", args.out.display());
+    }
+    let ck = load_checkpoint(&args.model)
+        .with_context(|| format!("loading {}", args.model.display()))?;
+    let device = DeviceArg::Cpu.device()?;
+    let network = ck.model(&device)?;
+    if let Some(dir) = args.out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    save_checkpoint(&args.out, &network, None, &ck.setup, &ck.loss, &ck.state)?;
+    let data = EvalData::open(&args.data)?;
+    let eval = data.evaluate(&args.out, &args.split, args.max_samples, &device)?;
+    let card = model_card(
+        &args.model,
+        &args.out,
+        &ck,
+        network.num_params(),
+        &data,
+        &args.split,
+        &eval,
+    )?;
+    let card_path = args.out.with_extension("md");
+    geom::io::write_bytes_atomic(&card_path, card.as_bytes())?;
+    eprintln!(
+        "wrote {} ({:.1} MB) and {}",
+        args.out.display(),
+        std::fs::metadata(&args.out)?.len() as f64 / 1e6,
+        card_path.display()
+    );
+    Ok(())
+}
+
+/// The model card (Markdown) of the exported model at `path`.
+fn model_card(
+    source: &Path,
+    path: &Path,
+    ck: &Checkpoint,
+    params: usize,
+    data: &EvalData,
+    split: &str,
+    eval: &ModelEvaluation,
+) -> anyhow::Result<String> {
+    let setup = &ck.setup;
+    let cfg = &setup.config;
+    let state = &ck.state;
+    let loss = &ck.loss;
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("model");
+    let size_mb = std::fs::metadata(path)?.len() as f64 / 1e6;
+    let manifest = data.dataset().manifest();
+    let train = data
+        .dataset()
+        .select(Some("train"), Some(&eval.garment))?
+        .len();
+    let [net, dqs] = eval.summary();
+    let (net_ms, sim_s) = eval.times();
+    let mut md = format!(
+        "# Model card: GarNet-{variant} for the {garment}\n\n\
+         `{name}` ({size_mb:.1} MB): the network ({params} parameters), the garment template it \
+         drapes ({n} vertices, {f} faces, carried in the file with its skinning weights) and \
+         the body points it sees ({p} of the body's {v} vertices). `garnet drape --model \
+         {name} [shape] [pose]` needs nothing else.\n\n",
+        variant = cfg.variant.name(),
+        garment = eval.garment,
+        n = setup.template.vertices.len(),
+        f = setup.template.faces.len(),
+        p = setup.body_sampling.len(),
+        v = setup.body_sampling.n_body,
+    );
+    md += &format!(
+        "## Training\n\n\
+         - dataset: '{ds}' (`{dir}`, spec `{dir}/spec.toml`), {train} training samples of this \
+         garment; validation on its 'val' split\n\
+         - command: `{cmd}`\n\
+         - progress: {ep} epochs, {st} steps, last learning rate {lr:e}; best validation E_dist \
+         {best}\n\
+         - loss: L_vertex + {pen} L_pen + {norm} L_norm + {bend} L_bend, lengths in {unit}, \
+         d_tol {dtol} m\n\n",
+        ds = manifest.spec.name,
+        dir = data.dataset().dir().display(),
+        cmd = state
+            .command
+            .as_deref()
+            .unwrap_or("(not recorded in the checkpoint)"),
+        ep = state.epoch,
+        st = state.step,
+        lr = state.lr,
+        best = state
+            .best_e_dist_cm
+            .map_or("n/a".to_string(), |b| format!("{b:.2} cm")),
+        pen = loss.pen,
+        norm = loss.norm,
+        bend = loss.bend,
+        unit = match loss.units_per_metre {
+            u if u == 100.0 => "cm".to_string(),
+            u if u == 1.0 => "m".to_string(),
+            u => format!("units of 1/{u} m"),
+        },
+        dtol = loss.d_tol,
+    );
+    md += &format!(
+        "## Test metrics ('{split}' split: bodies never seen in training)\n\n\
+         | method | samples | E_dist (cm) | E_norm (deg) | vertices inside the body |\n\
+         |---|---:|---:|---:|---:|\n"
+    );
+    for (method, (samples, dist, norm, inside)) in [
+        (format!("GarNet-{}", cfg.variant.name()), net),
+        ("DQS warp (the input M)".to_string(), dqs),
+    ] {
+        md += &format!(
+            "| {method} | {samples} | {dist:.2} | {norm:.1} | {:.1}% |\n",
+            inside * 100.0
+        );
+    }
+    md += &format!(
+        "\nTime per drape on this machine: network {net_ms:.0} ms (median, batch 1, CPU){}.\n",
+        sim_s.map_or(String::new(), |s| format!(
+            "; the simulator took {s:.2} s on the same samples ({:.0}x)",
+            s * 1e3 / net_ms.max(1e-9)
+        ))
+    );
+    md += &format!(
+        "\nMade by `garnet export --model {} --data {} --out {}`.\n",
+        source.display(),
+        data.dataset().dir().display(),
+        path.display()
+    );
+    Ok(md)
+}
