@@ -33,6 +33,13 @@ pub enum BenchCmd {
         /// Garment vertex counts (comma-separated).
         #[arg(long, value_delimiter = ',', default_value = "3000,10000")]
         sizes: Vec<usize>,
+        /// Also drape the T-shirt on the benchmark body with GarNet-Local and with the
+        /// simulator: the time of each on the same drape and their ratio.
+        #[arg(long)]
+        simulator: bool,
+        /// Edge length of the reference T-shirt, metres (0.01: ~8k vertices).
+        #[arg(long, default_value_t = 0.01)]
+        edge: f32,
     },
 }
 
@@ -40,7 +47,12 @@ pub fn run(cmd: &BenchCmd) -> anyhow::Result<()> {
     match cmd {
         BenchCmd::Body { repeat } => bench_body(*repeat.max(&3)),
         BenchCmd::Sim { edge, seed } => bench_sim(*edge, *seed),
-        BenchCmd::Model { runs, sizes } => crate::bench_model::bench_model(*runs, sizes),
+        BenchCmd::Model {
+            runs,
+            sizes,
+            simulator,
+            edge,
+        } => crate::bench_model::bench_model(*runs, sizes, *simulator, *edge),
     }
 }
 
@@ -158,32 +170,30 @@ impl TshirtCase {
             warp,
         })
     }
+
+    /// Drapes the T-shirt on the posed body with the simulator (default options, except
+    /// that penetration is reported instead of failing the drape).
+    pub fn simulate(&self) -> anyhow::Result<sim::drape::Drape> {
+        let opts = sim::drape::DrapeOptions {
+            max_penetration: f32::INFINITY,
+            ..sim::drape::DrapeOptions::default()
+        };
+        Ok(sim::drape::drape(
+            &self.template,
+            &self.template_body,
+            &self.target,
+            &self.pose,
+            &opts,
+            &mut |_, _, _| {},
+        )?)
+    }
 }
 
 fn bench_sim(edge: f32, seed: u64) -> anyhow::Result<()> {
-    use sim::drape::{drape, DrapeOptions};
-
     let model = BodyModel::load()?;
-    let TshirtCase {
-        template,
-        template_body,
-        target,
-        pose,
-        warp,
-    } = TshirtCase::new(&model, edge, seed)?;
-    // The bench reports the penetration instead of failing on it.
-    let opts = DrapeOptions {
-        max_penetration: f32::INFINITY,
-        ..DrapeOptions::default()
-    };
-    let result = drape(
-        &template,
-        &template_body,
-        &target,
-        &pose,
-        &opts,
-        &mut |_, _, _| {},
-    )?;
+    let case = TshirtCase::new(&model, edge, seed)?;
+    let (template, warp) = (&case.template, case.warp);
+    let result = case.simulate()?;
     let s = &result.stats;
     let steps = s.animation_steps + s.settle_steps;
     let per_step = s.wall_time_s / steps as f64;

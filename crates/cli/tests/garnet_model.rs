@@ -262,15 +262,25 @@ fn as_str(v: &[String]) -> Vec<&str> {
 
 #[test]
 fn bench_model_reports_every_variant_against_the_dqs_warp() {
-    let out = ok(&["bench", "model", "--runs", "1", "--sizes", "300"]);
+    let out = ok(&[
+        "bench",
+        "model",
+        "--runs",
+        "1",
+        "--sizes",
+        "300",
+        "--edge",
+        "0.05",
+        "--simulator",
+    ]);
     assert!(out.contains("DQS warp (reference)"), "{out}");
-    for variant in ["| local |", "| global |", "| naive |"] {
+    // A drape row and a training-step row each; GarNet-Local also on the simulator's drape.
+    for (variant, count) in [("| local |", 3), ("| global |", 2), ("| naive |", 2)] {
         let rows = out.lines().filter(|l| l.contains(variant)).count();
-        assert_eq!(
-            rows, 2,
-            "{variant}: a drape row and a training-step row\n{out}"
-        );
+        assert_eq!(rows, count, "{variant}\n{out}");
     }
+    assert!(out.contains("same drape: simulator to rest"), "{out}");
+    assert!(out.contains("faster than the simulator"), "{out}");
 }
 
 /// The main job (no command, run from any folder): the three shipped models drape a random

@@ -66,8 +66,12 @@ impl ModelSetup {
         template: geom::TriMesh,
         reference_body: &[Vec3],
     ) -> Result<Self> {
+        let mut config = config;
         config.validate()?;
         template.validate()?;
+        let n = template.vertices.len().max(1) as f32;
+        let centroid = template.vertices.iter().copied().sum::<Vec3>() / n;
+        config.input_centre = centroid.to_array().to_vec();
         let body_sampling = BodySampling::farthest_point(
             reference_body,
             config.body_subsample,
@@ -274,8 +278,16 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint> {
         meta.get(key)
             .ok_or_else(|| bad(format!("missing metadata {key}")))
     };
-    let config: GarNetConfig =
+    let mut config_json: serde_json::Value =
         serde_json::from_str(field("config")?).map_err(|e| bad(format!("metadata config: {e}")))?;
+    // Checkpoints written before the input unit existed take positions in metres.
+    if let Some(obj) = config_json.as_object_mut() {
+        obj.entry("input_scale").or_insert(serde_json::json!(1.0));
+        obj.entry("input_centre")
+            .or_insert(serde_json::json!([0.0, 0.0, 0.0]));
+    }
+    let config: GarNetConfig =
+        serde_json::from_value(config_json).map_err(|e| bad(format!("metadata config: {e}")))?;
     let mut loss_json: serde_json::Value =
         serde_json::from_str(field("loss")?).map_err(|e| bad(format!("metadata loss: {e}")))?;
     // Checkpoints written before the loss had a unit were trained in metres.

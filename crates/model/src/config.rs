@@ -130,6 +130,17 @@ pub struct GarNetConfig {
     /// components, so three hidden widths make the paper's four MLP blocks.
     #[config(default = "vec![128, 64, 32]")]
     pub fusion: Vec<usize>,
+    /// Length unit of the network's inputs and outputs, metres: positions enter as
+    /// `(p - input_centre) / input_scale` and the predicted translations leave multiplied by
+    /// it. In metres (1.0) the per-vertex part of every feature is hundreds of times smaller
+    /// than the per-sample body feature added to it, and the network cannot tell the garment's
+    /// vertices apart (see docs/model.md); 0.1 gives unit-sized inputs.
+    #[config(default = 0.1)]
+    pub input_scale: f32,
+    /// Centre subtracted from every input position (metres, the canonical frame):
+    /// [`crate::ModelSetup::new`] sets the garment template's centroid.
+    #[config(default = "vec![0.0, 0.0, 0.0]")]
+    pub input_centre: Vec<f32>,
     /// Seed of the initial parameter values.
     #[config(default = 0)]
     pub seed: u64,
@@ -190,6 +201,16 @@ impl GarNetConfig {
                     "config {name} must be positive"
                 )));
             }
+        }
+        if !(self.input_scale.is_finite() && self.input_scale > 0.0)
+            || self.input_centre.len() != 3
+            || self.input_centre.iter().any(|c| !c.is_finite())
+        {
+            return Err(ModelError::InvalidInput(format!(
+                "config input_scale must be positive and input_centre 3 finite numbers, got \
+                 {} and {:?}",
+                self.input_scale, self.input_centre
+            )));
         }
         if self.variant.has_mesh_conv() && (self.conv_blocks == 0 || self.convs_per_block == 0) {
             return Err(ModelError::InvalidInput(

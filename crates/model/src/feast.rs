@@ -16,6 +16,11 @@ use burn::prelude::*;
 
 use crate::init::ParamInit;
 
+/// Largest span of a batch's assignment logits (over the heads of one vertex, plus the
+/// span of the offsets) for which the factored assignment is used: its factors stay above
+/// `exp(-2 * 30)`, far from f32 underflow.
+pub const FACTORED_SPAN: f32 = 30.0;
+
 /// One FeaStNet convolution `d_in -> d_out` with `heads` soft-assignment heads.
 #[derive(Module, Debug)]
 pub struct FeaStConv {
@@ -82,7 +87,9 @@ impl FeaStConv {
     /// which cancels in the normalisation) and only the product and the normalisation run per
     /// neighbour: the same values as a softmax over the logits, without its `[B,N,K,M]`
     /// broadcasts (3-4x faster on flex). An assignment can only lose precision when one
-    /// vertex's logits span more than ~80 (then the smallest factors underflow).
+    /// vertex's logits span more than ~80 (then the factors underflow, and their gradients
+    /// overflow): when a batch's logits span more than [`FACTORED_SPAN`], the assignment is
+    /// computed as a plain softmax over the `[B,N,K,M]` logits instead.
     pub fn assignment(
         &self,
         x: Tensor<3>,
@@ -93,7 +100,16 @@ impl FeaStConv {
         let k = ring_weight.dims()[2];
         let m = self.heads();
         let a = self.u.forward(x); // [B,N,M]
-        let ac = a.clone() + self.c.val().reshape([1, 1, m]);
+        let c = self.c.val();
+        let span = (a.clone().max_dim(2) - a.clone().min_dim(2)).max().detach()
+            + (c.clone().max() - c.clone().min()).detach();
+        let span = crate::tensors::read_scalar(span).unwrap_or(f32::INFINITY);
+        if !(span < FACTORED_SPAN) {
+            let a_j = a.clone().select(1, ring.clone()).reshape([b, n, k, m]);
+            let logits = a_j - a.unsqueeze_dim::<4>(2) + c.reshape([1, 1, 1, m]);
+            return burn::tensor::activation::softmax(logits, 3) * ring_weight.clone();
+        }
+        let ac = a.clone() + c.reshape([1, 1, m]);
         let e = (ac.clone() - ac.max_dim(2).detach()).exp(); // E_j, in (0, 1]
         let na = a.neg();
         let f = (na.clone() - na.max_dim(2).detach()).exp(); // F_i, in (0, 1]
@@ -172,33 +188,43 @@ mod tests {
         let mut init = ParamInit::new(11);
         let mut conv = FeaStConv::new(d_in, d_out, heads, &mut init, &device);
         conv.c = init.vector(heads, 1.0, &device);
-        let mut rng = rand::rngs::StdRng::seed_from_u64(3);
-        let x: Vec<Vec<Vec<f64>>> = (0..b)
-            .map(|_| {
-                (0..n)
-                    .map(|_| (0..d_in).map(|_| rng.random_range(-2.0..2.0)).collect())
-                    .collect()
-            })
-            .collect();
-        let flat: Vec<f32> = x.iter().flatten().flatten().map(|&v| v as f32).collect();
-        let y = conv.forward(
-            vec_tensor(flat, [b, n, d_in], &device),
-            &tt.ring,
-            &tt.ring_weight,
-        );
-        assert_eq!(y.dims(), [b, n, d_out]);
-        let got = read_f32(y).unwrap();
-        let want: Vec<f64> = reference(&conv, &mesh, &x)
-            .into_iter()
-            .flatten()
-            .flatten()
-            .collect();
-        let worst = got
-            .iter()
-            .zip(&want)
-            .map(|(g, w)| (*g as f64 - w).abs())
-            .fold(0.0, f64::max);
-        assert!(worst < 1e-5, "largest difference {worst}");
+        // Features within +-2 take the factored assignment, within +-80 (logits spanning more
+        // than FACTORED_SPAN) the plain softmax: both must match the loops.
+        for (range, factored) in [(2.0, true), (80.0, false)] {
+            let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+            let x: Vec<Vec<Vec<f64>>> = (0..b)
+                .map(|_| {
+                    (0..n)
+                        .map(|_| (0..d_in).map(|_| rng.random_range(-range..range)).collect())
+                        .collect()
+                })
+                .collect();
+            let flat: Vec<f32> = x.iter().flatten().flatten().map(|&v| v as f32).collect();
+            let x_t = vec_tensor(flat, [b, n, d_in], &device);
+            let a = read_f32(conv.u.forward(x_t.clone())).unwrap();
+            let span = a
+                .chunks_exact(heads)
+                .map(|r| {
+                    r.iter().fold(f32::MIN, |m, v| m.max(*v))
+                        - r.iter().fold(f32::MAX, |m, v| m.min(*v))
+                })
+                .fold(0.0f32, f32::max);
+            assert_eq!(span + 2.0 < FACTORED_SPAN, factored, "logit span {span}");
+            let y = conv.forward(x_t, &tt.ring, &tt.ring_weight);
+            assert_eq!(y.dims(), [b, n, d_out]);
+            let got = read_f32(y).unwrap();
+            let want: Vec<f64> = reference(&conv, &mesh, &x)
+                .into_iter()
+                .flatten()
+                .flatten()
+                .collect();
+            let worst = got
+                .iter()
+                .zip(&want)
+                .map(|(g, w)| ((*g as f64 - w) / (1.0 + w.abs())).abs())
+                .fold(0.0, f64::max);
+            assert!(worst < 5e-5, "range {range}: largest difference {worst}");
+        }
     }
 
     #[test]

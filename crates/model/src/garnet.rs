@@ -23,6 +23,10 @@ pub struct GarNet {
     pub local: Option<LocalPool>,
     /// Fusion network.
     pub fusion: Fusion,
+    /// Input and output length unit, metres (see [`GarNetConfig::input_scale`]).
+    pub input_scale: f32,
+    /// Centre subtracted from input positions `[3]`, metres.
+    pub input_centre: Vec<f32>,
 }
 
 impl GarNetConfig {
@@ -51,6 +55,8 @@ impl GarNetConfig {
             garment,
             local,
             fusion,
+            input_scale: self.input_scale,
+            input_centre: self.input_centre.clone(),
         })
     }
 }
@@ -68,7 +74,8 @@ impl GarNet {
         }
     }
 
-    /// Predicted translations `T` `[B,N,3]` (metres).
+    /// Predicted translations `T` `[B,N,3]` (metres). Positions are moved to the network's
+    /// unit ([`GarNetConfig::input_scale`]) inside.
     ///
     /// - `body`: the body points the stream sees `[B,P,3]` (see
     ///   [`crate::local::BodySampling::stream_points`]), metres.
@@ -97,6 +104,11 @@ impl GarNet {
                 got: n,
             });
         }
+        let centre = Tensor::<1>::from_floats(self.input_centre.as_slice(), &body.device())
+            .reshape([1, 1, 3]);
+        let unit = self.input_scale as f64;
+        let body = (body - centre.clone()) / unit;
+        let warped = (warped - centre) / unit;
         let body_features = self.body.forward(body);
         let garment = self
             .garment
@@ -128,7 +140,7 @@ impl GarNet {
             Tensor::cat(per_vertex, 2)
         };
         let global = Tensor::cat(vec![garment.global, body_features.global], 1);
-        Ok(self.fusion.forward(per_vertex, global))
+        Ok(self.fusion.forward(per_vertex, global) * unit)
     }
 
     /// The predicted draped garment `G = M + T` `[B,N,3]` (metres); arguments as
