@@ -6,7 +6,7 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use common::{fails, ok, s};
+use common::{fails, garnet, ok, s};
 
 /// 3 bodies (train, val, test) x T-shirt in 2 poses: 6 samples of an 8 cm T-shirt.
 const SPEC: &str = r#"
@@ -149,15 +149,18 @@ fn train_resume_eval_and_drape() {
 
     // Export: the network without the optimiser state, and its model card.
     let shipped = tmp.path().join("models").join("tshirt-local.garnet");
-    ok(&[
-        "export",
-        "--model",
-        s(&best),
-        "--data",
-        s(data),
-        "--out",
-        s(&shipped),
-    ]);
+    let export = |out: &Path| {
+        garnet(&[
+            "export",
+            "--model",
+            s(&best),
+            "--data",
+            s(data),
+            "--out",
+            s(out),
+        ])
+    };
+    assert!(export(&shipped).status.success());
     let size = |p: &Path| std::fs::metadata(p).unwrap().len();
     assert!(
         size(&shipped) * 2 < size(&best),
@@ -176,15 +179,10 @@ fn train_resume_eval_and_drape() {
     ] {
         assert!(card.contains(needle), "{needle} missing:\n{card}");
     }
-    let err = fails(&[
-        "export",
-        "--model",
-        s(&best),
-        "--data",
-        s(data),
-        "--out",
-        s(&tmp.path().join("model.bin")),
-    ]);
+    let refused = export(&tmp.path().join("model.bin"));
+    assert!(!refused.status.success());
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(!err.contains("panicked"), "{err}");
     assert!(
         err.contains("model.bin") && err.contains(".garnet"),
         "{err}"
