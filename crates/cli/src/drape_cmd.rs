@@ -43,7 +43,8 @@ pub struct DrapeArgs {
     /// Also write the posed body mesh here.
     #[arg(long, value_name = "FILE")]
     pub body_out: Option<PathBuf>,
-    /// Picture of the body wearing the garments.
+    /// Picture of the body wearing the garment; with several models, one per garment with
+    /// its kind added to the name (`drape-tshirt.png`).
     #[arg(long, value_name = "FILE.png")]
     pub png: Option<PathBuf>,
     /// Where the networks run.
@@ -70,8 +71,8 @@ pub fn shipped_models_dir() -> PathBuf {
 
 impl DrapeArgs {
     /// The main job: the three shipped models on a random realistic adult (shape seed 1) in
-    /// a procedural pose (seed 1), written to `out/draped-GARMENT.glb`, `out/body.glb` and a
-    /// picture `out/drape.png`. Fails, naming the folder, when the models are missing.
+    /// a procedural pose (seed 1), written to `out/draped-GARMENT.glb`, `out/body.glb` and
+    /// pictures `out/drape-GARMENT.png`. Fails, naming the folder, when the models are missing.
     pub fn main_job() -> anyhow::Result<Self> {
         let dir = shipped_models_dir();
         let models: Vec<PathBuf> = SHIPPED_MODELS.iter().map(|m| dir.join(m)).collect();
@@ -125,7 +126,7 @@ pub fn run(args: &DrapeArgs) -> anyhow::Result<()> {
         clear_limbs(&target, &pose, &ClearanceOptions::default())?.0
     };
     let body = target.posed(&pose, Skinning::Dqs)?;
-    let mut scene: Vec<(TriMesh, [u8; 3])> = Vec::new();
+    let mut scene: Vec<(String, TriMesh, [u8; 3])> = Vec::new();
     let several = args.models.len() > 1;
     for path in &args.models {
         let draper =
@@ -151,32 +152,40 @@ pub fn run(args: &DrapeArgs) -> anyhow::Result<()> {
             vertices: draped,
             faces: template.mesh.faces.clone(),
         };
+        let kind = template.kind.name();
         let out = if several {
-            let stem = args
-                .out
-                .file_stem()
-                .and_then(|s| s.to_str())
-                .unwrap_or("draped");
-            let ext = args
-                .out
-                .extension()
-                .and_then(|s| s.to_str())
-                .unwrap_or("glb");
-            args.out
-                .with_file_name(format!("{stem}-{}.{ext}", template.kind.name()))
+            with_kind(&args.out, kind)
         } else {
             args.out.clone()
         };
         write_mesh(&out, &mesh)?;
-        scene.push((mesh, garment_color(&template.kind)));
+        scene.push((kind.to_string(), mesh, garment_color(&template.kind)));
     }
     if let Some(p) = &args.body_out {
         write_mesh(p, &body)?;
     }
     if let Some(png) = &args.png {
-        let mut meshes: Vec<(&TriMesh, [u8; 3])> = vec![(&body, palette::SKIN)];
-        meshes.extend(scene.iter().map(|(m, c)| (m, *c)));
-        write_png(png, &meshes, (480, 720))?;
+        // One picture per garment: two tops drawn over each other would hide both.
+        for (kind, mesh, color) in &scene {
+            let path = if several {
+                with_kind(png, kind)
+            } else {
+                png.clone()
+            };
+            write_png(&path, &[(&body, palette::SKIN), (mesh, *color)], (480, 720))?;
+        }
     }
     Ok(())
+}
+
+/// `path` with `-KIND` added to its file stem (`out/draped.glb` -> `out/draped-tshirt.glb`).
+fn with_kind(path: &Path, kind: &str) -> PathBuf {
+    let stem = path
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("draped");
+    match path.extension().and_then(|s| s.to_str()) {
+        Some(ext) => path.with_file_name(format!("{stem}-{kind}.{ext}")),
+        None => path.with_file_name(format!("{stem}-{kind}")),
+    }
 }

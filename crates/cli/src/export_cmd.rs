@@ -130,8 +130,8 @@ fn model_card(
         norm = loss.norm,
         bend = loss.bend,
         unit = match loss.units_per_metre {
-            u if u == 100.0 => "cm".to_string(),
-            u if u == 1.0 => "m".to_string(),
+            100.0 => "cm".to_string(),
+            1.0 => "m".to_string(),
             u => format!("units of 1/{u} m"),
         },
         dtol = loss.d_tol,

@@ -26,7 +26,7 @@ use clap::{Parser, Subcommand};
 ///
 /// With no command, runs the main job on the embedded defaults: the three shipped GarNet
 /// models (models/) drape a T-shirt, a sweater and jeans on a random realistic adult in a
-/// procedural pose, written to out/draped-*.glb, out/body.glb and out/drape.png.
+/// procedural pose, written to out/draped-*.glb, out/body.glb and out/drape-*.png.
 #[derive(Parser, Debug)]
 #[command(name = "garnet", version, about, long_about)]
 struct Cli {

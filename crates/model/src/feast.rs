@@ -104,7 +104,7 @@ impl FeaStConv {
         let span = (a.clone().max_dim(2) - a.clone().min_dim(2)).max().detach()
             + (c.clone().max() - c.clone().min()).detach();
         let span = crate::tensors::read_scalar(span).unwrap_or(f32::INFINITY);
-        if !(span < FACTORED_SPAN) {
+        if span.is_nan() || span >= FACTORED_SPAN {
             let a_j = a.clone().select(1, ring.clone()).reshape([b, n, k, m]);
             let logits = a_j - a.unsqueeze_dim::<4>(2) + c.reshape([1, 1, 1, m]);
             return burn::tensor::activation::softmax(logits, 3) * ring_weight.clone();
