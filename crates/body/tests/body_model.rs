@@ -163,14 +163,25 @@ fn random_shapes_are_realistic_adults_and_reproducible() {
     assert!(spread > 0.08, "shapes vary: spread {spread}");
 }
 
-#[test]
-fn cmu_walk_frames_stand_upright_with_feet_on_the_floor_and_arms_at_the_sides() {
+/// CMU subject 02's clip `name` from the shared mocap folder; `None` (the test is skipped)
+/// when the folder is absent.
+fn cmu_02_clip(name: &str) -> Option<body::pose::Clip> {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/mocap/cmu/02");
     if !dir.is_dir() {
         eprintln!("skipped: ../shared/mocap not present");
-        return;
+        return None;
     }
-    let clip = body::pose::Clip::from_asf_amc(dir.join("02.asf"), dir.join("02_01.amc")).unwrap();
+    Some(
+        body::pose::Clip::from_asf_amc(dir.join("02.asf"), dir.join(format!("{name}.amc")))
+            .unwrap(),
+    )
+}
+
+#[test]
+fn cmu_walk_frames_stand_upright_with_feet_on_the_floor_and_arms_at_the_sides() {
+    let Some(clip) = cmu_02_clip("02_01") else {
+        return;
+    };
     let body = model()
         .shape(&Phenotype {
             gender: 0.0,
@@ -302,12 +313,9 @@ fn clearance_leaves_the_rest_pose_alone_and_lifts_an_arm_out_of_the_chest() {
 #[test]
 fn clearance_leaves_a_gap_for_the_cloth_under_an_arm_across_the_chest() {
     use body::clearance::{clear_limbs, ClearanceOptions, PROBE};
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/mocap/cmu/02");
-    if !dir.is_dir() {
-        eprintln!("skipped: ../shared/mocap not present");
+    let Some(clip) = cmu_02_clip("02_07") else {
         return;
-    }
-    let clip = body::pose::Clip::from_asf_amc(dir.join("02.asf"), dir.join("02_07.amc")).unwrap();
+    };
     let m = model();
     let shape = body::shape_sampler::ShapeDistribution::default()
         .sample(m, 100)

@@ -120,6 +120,26 @@ impl InputSpec {
         }
     }
 
+    /// Each (body `[V]`, warped garment `[N]`) pair moved into its canonical frame: the
+    /// frames, the bodies and the warped garments (metres).
+    pub fn to_canonical(
+        &self,
+        pairs: &[(&[Vec3], &[Vec3])],
+    ) -> (Vec<CanonicalFrame>, Vec<Vec<Vec3>>, Vec<Vec<Vec3>>) {
+        let frames: Vec<CanonicalFrame> = pairs.iter().map(|(_, w)| self.frame(w)).collect();
+        let bodies = pairs
+            .iter()
+            .zip(&frames)
+            .map(|((b, _), f)| f.points_to_canonical(b))
+            .collect();
+        let warped = pairs
+            .iter()
+            .zip(&frames)
+            .map(|((_, w), f)| f.points_to_canonical(w))
+            .collect();
+        (frames, bodies, warped)
+    }
+
     /// The network inputs of B samples: stream points `[B][P]` of `bodies` `[B][V]`, and the
     /// local tables of them and `warped` `[B][N]` when the spec has them.
     pub fn inputs(
@@ -176,8 +196,6 @@ pub struct Batch {
     pub(crate) body_index: Vec<Arc<geom::KnnIndex>>,
     /// Targets on the CPU `[B][N]`, canonical frame (the penetration mask and the metrics).
     pub(crate) target_points: Option<Vec<Vec<Vec3>>>,
-    /// Each sample's canonical frame: every tensor of the batch is in it.
-    pub frames: Vec<CanonicalFrame>,
 }
 
 impl std::fmt::Debug for Batch {
@@ -225,17 +243,16 @@ impl Batch {
                 check_finite("target garment G", t)?;
             }
         }
-        let frames: Vec<CanonicalFrame> = samples.iter().map(|s| spec.frame(&s.warped)).collect();
-        let moved = |points: fn(&Sample) -> &[Vec3]| -> Vec<Vec<Vec3>> {
-            samples
-                .iter()
-                .zip(&frames)
-                .map(|(s, f)| f.points_to_canonical(points(s)))
-                .collect()
-        };
-        let bodies = moved(|s| &s.body);
-        let warped = moved(|s| &s.warped);
-        let targets = moved(|s| s.target.as_deref().unwrap_or(&[]));
+        let pairs: Vec<(&[Vec3], &[Vec3])> = samples
+            .iter()
+            .map(|s| (s.body.as_slice(), s.warped.as_slice()))
+            .collect();
+        let (frames, bodies, warped) = spec.to_canonical(&pairs);
+        let targets: Vec<Vec<Vec3>> = samples
+            .iter()
+            .zip(&frames)
+            .map(|(s, f)| f.points_to_canonical(s.target.as_deref().unwrap_or(&[])))
+            .collect();
         let normals: Vec<Vec<Vec3>> = samples
             .iter()
             .zip(&frames)
@@ -281,7 +298,6 @@ impl Batch {
             local,
             body_index,
             target_points,
-            frames,
         })
     }
 

@@ -8,7 +8,6 @@ use glam::Vec3;
 use crate::batch::InputSpec;
 use crate::checkpoint::{load_checkpoint, ModelSetup};
 use crate::error::{check_count, check_finite, ModelError, Result};
-use crate::frame::CanonicalFrame;
 use crate::garnet::GarNet;
 use crate::tensors::{points_tensor, read_points};
 use crate::topology::{GarmentTopology, TopologyTensors};
@@ -116,17 +115,7 @@ impl Draper {
         for (body, warped) in items {
             self.check(body, warped)?;
         }
-        let frames: Vec<CanonicalFrame> = items.iter().map(|p| self.spec.frame(p.1)).collect();
-        let bodies: Vec<Vec<Vec3>> = items
-            .iter()
-            .zip(&frames)
-            .map(|(p, f)| f.points_to_canonical(p.0))
-            .collect();
-        let warped: Vec<Vec<Vec3>> = items
-            .iter()
-            .zip(&frames)
-            .map(|(p, f)| f.points_to_canonical(p.1))
-            .collect();
+        let (frames, bodies, warped) = self.spec.to_canonical(items);
         let bodies: Vec<&[Vec3]> = bodies.iter().map(Vec::as_slice).collect();
         let warped: Vec<&[Vec3]> = warped.iter().map(Vec::as_slice).collect();
         let (stream, local) = self.spec.inputs(&bodies, &warped, &self.device)?;
