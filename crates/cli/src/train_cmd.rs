@@ -11,7 +11,7 @@ use dataset::batches::{BatchOptions, Batches, Order};
 use dataset::Dataset;
 use indicatif::{ProgressBar, ProgressStyle};
 use model::{
-    BodyTopology, GarNetConfig, LossConfig, ModelSetup, Sample, Trainer, Variant,
+    BodyTopology, CosineSchedule, GarNetConfig, LossConfig, ModelSetup, Sample, Trainer, Variant,
     PAPER_LEARNING_RATE,
 };
 
@@ -38,6 +38,15 @@ pub struct TrainArgs {
     /// Adam learning rate (the paper: 1e-3).
     #[arg(long, default_value_t = PAPER_LEARNING_RATE)]
     pub lr: f64,
+    /// Clip the gradients of each step to this joint L2 norm (as PyTorch's
+    /// `clip_grad_norm_`); kept by a resumed run unless given again. The metrics log's
+    /// `train_grad_norm` column shows the norms before clipping.
+    #[arg(long, value_name = "NORM")]
+    pub grad_clip: Option<f32>,
+    /// Anneal the learning rate along half a cosine from --lr (at the epoch this run starts
+    /// from) to this rate at --epochs; resuming with the same command continues the schedule.
+    #[arg(long, value_name = "LR")]
+    pub cosine_to: Option<f64>,
     /// Output folder (checkpoints `best.garnet`, `last.garnet`, `metrics.csv`); default
     /// `runs/GARMENT-VARIANT`.
     #[arg(long, value_name = "DIR")]
@@ -201,6 +210,14 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
             .with_garment_file(garment_file);
         Trainer::new(setup, loss_config(args), args.lr, &device)?
     };
+    if args.grad_clip.is_some() {
+        trainer.set_max_grad_norm(args.grad_clip)?;
+    }
+    let schedule = args
+        .cosine_to
+        .map(|end| CosineSchedule::new(args.lr, end, trainer.state().epoch, args.epochs))
+        .transpose()?;
+    trainer.set_schedule(schedule);
     trainer.set_command(
         std::iter::once("garnet".to_string())
             .chain(std::env::args().skip(1))
@@ -210,13 +227,23 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
     let params = trainer.model().num_params();
     eprintln!(
         "training GarNet-{} ({params} parameters) on {} '{}' samples ({} validation), \
-         batch {}, lr {}, into {}",
+         batch {}, lr {}{}{}, into {}",
         variant.name(),
         train.indices.len(),
         args.garment,
         valid.as_ref().map_or(0, |v| v.indices.len()),
         args.batch,
         args.lr,
+        trainer.state().schedule.map_or(String::new(), |s| format!(
+            " (cosine to {} at epoch {}, from epoch {})",
+            s.end_lr, s.to_epoch, s.from_epoch
+        )),
+        trainer
+            .state()
+            .max_grad_norm
+            .map_or(String::new(), |n| format!(
+                ", gradients clipped to norm {n}"
+            )),
         out.display()
     );
     let batches_per_epoch = train.indices.len().div_ceil(args.batch.max(1)) as u64;
@@ -253,14 +280,16 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
             )
         });
         bar.suspend(|| eprintln!(
-            "epoch {} ({:.1} s): loss {:.3e} (vertex {:.3e} pen {:.3e} norm {:.3e} bend {:.3e}){v}{}",
+            "epoch {} ({:.1} s, lr {:.2e}): loss {:.3e} (vertex {:.3e} pen {:.3e} norm {:.3e} bend {:.3e}), grad norm {:.3e}{v}{}",
             r.epoch,
             r.seconds,
+            r.lr,
             r.train.total,
             r.train.vertex,
             r.train.pen,
             r.train.norm,
             r.train.bend,
+            r.grad_norm,
             if r.is_best { " *best" } else { "" }
         ))
     })?;

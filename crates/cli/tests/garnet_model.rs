@@ -100,8 +100,9 @@ fn train_resume_eval_and_drape() {
     assert!(log.contains("resuming"), "{log}");
     assert_eq!(rows(&metrics), 4);
 
+    // Naive with clipped gradients and a cosine schedule over two epochs.
     let naive = tmp.path().join("naive");
-    ok(&[
+    let log = ok(&[
         "train",
         "--data",
         s(data),
@@ -110,10 +111,23 @@ fn train_resume_eval_and_drape() {
         "--variant",
         "naive",
         "--epochs",
-        "1",
+        "2",
+        "--grad-clip",
+        "100",
+        "--cosine-to",
+        "1e-4",
         "--out",
         s(&naive),
     ]);
+    assert!(
+        log.contains("cosine to 0.0001 at epoch 2, from epoch 0")
+            && log.contains("gradients clipped to norm 100")
+            && log.contains("lr 1.00e-3")
+            && log.contains("lr 5.50e-4"),
+        "{log}"
+    );
+    let csv = std::fs::read_to_string(naive.join("metrics.csv")).unwrap();
+    assert!(csv.lines().next().unwrap().ends_with(",train_grad_norm"));
 
     // Table 1 / Table 2 / precision curves.
     let eval = tmp.path().join("eval");

@@ -35,6 +35,7 @@ use crate::error::{ModelError, Result};
 use crate::garnet::GarNet;
 use crate::local::BodySampling;
 use crate::loss::LossConfig;
+use crate::schedule::CosineSchedule;
 
 /// The format name in a checkpoint's metadata.
 pub const FORMAT: &str = "garnet-model-1";
@@ -142,6 +143,12 @@ pub struct TrainState {
     /// The command line of the latest training run (for model cards), when it was given.
     #[serde(default)]
     pub command: Option<String>,
+    /// Joint L2 norm the gradients are clipped to (`None`: no clipping).
+    #[serde(default)]
+    pub max_grad_norm: Option<f32>,
+    /// Learning-rate schedule (`None`: the rate stays as set).
+    #[serde(default)]
+    pub schedule: Option<CosineSchedule>,
 }
 
 /// A checkpoint read from disk; [`Checkpoint::model`] and [`Checkpoint::optimizer`] rebuild

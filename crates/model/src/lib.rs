@@ -46,11 +46,13 @@ pub mod frame;
 pub mod fusion;
 pub mod garment_stream;
 pub mod garnet;
+pub mod grad_clip;
 mod init;
 pub mod layers;
 pub mod local;
 pub mod loss;
 pub mod metrics_log;
+pub mod schedule;
 pub mod stn;
 pub mod synthetic;
 pub mod tensors;
@@ -69,8 +71,9 @@ pub use garnet::GarNet;
 pub use init::LEAKY_SLOPE;
 pub use local::{BodySampling, LocalIndices};
 pub use loss::{garnet_loss, LossConfig, LossTerms};
+pub use schedule::CosineSchedule;
 pub use topology::{GarmentTopology, TopologyTensors};
-pub use train::{adam, evaluate_batch, train_step, Evaluation, PAPER_LEARNING_RATE};
+pub use train::{adam, evaluate_batch, train_step, Evaluation, StepReport, PAPER_LEARNING_RATE};
 pub use trainer::{EpochReport, Trainer, Validation};
 
 /// burn's optimiser type used for GarNet (Adam).

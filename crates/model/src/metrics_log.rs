@@ -3,13 +3,15 @@
 //! ```text
 //! epoch,step,lr,seconds,train_samples,train_total,train_vertex,train_pen,train_norm,
 //! train_bend,val_samples,val_total,val_vertex,val_pen,val_norm,val_bend,val_e_dist_cm,
-//! val_e_norm_deg,best
+//! val_e_norm_deg,best,train_grad_norm
 //! ```
 //!
-//! Loss terms in their units (vertex m^2, pen and bend m, norm none); the `val_*` fields are
-//! empty for an epoch without validation; `best` is 1 when the epoch wrote `best.garnet`.
-//! Appending a row drops any rows of that epoch or later (a resumed run rewrites the epochs
-//! after its checkpoint), and the file is rewritten atomically (temporary file, rename).
+//! Loss terms in the loss's units (cm by default: vertex cm^2, pen and bend cm, norm none);
+//! the `val_*` fields are empty for an epoch without validation; `best` is 1 when the epoch
+//! wrote `best.garnet`; `train_grad_norm` is the epoch's mean joint gradient norm before
+//! clipping. Appending a row drops any rows of that epoch or later (a resumed run rewrites
+//! the epochs after its checkpoint); rows of a log written before a column was added get an
+//! empty field for it. The file is rewritten atomically (temporary file, rename).
 
 use std::path::PathBuf;
 
@@ -20,7 +22,7 @@ use crate::trainer::Validation;
 /// The CSV header line.
 pub const HEADER: &str = "epoch,step,lr,seconds,train_samples,train_total,train_vertex,\
 train_pen,train_norm,train_bend,val_samples,val_total,val_vertex,val_pen,val_norm,val_bend,\
-val_e_dist_cm,val_e_norm_deg,best";
+val_e_dist_cm,val_e_norm_deg,best,train_grad_norm";
 
 /// One epoch's row.
 #[derive(Clone, Debug, PartialEq)]
@@ -37,6 +39,8 @@ pub struct MetricsRow {
     pub train: LossTerms,
     /// Training samples seen.
     pub train_samples: usize,
+    /// Mean joint gradient norm before clipping.
+    pub grad_norm: f32,
     /// Validation results.
     pub validation: Option<Validation>,
     /// Whether the epoch wrote the best checkpoint.
@@ -74,7 +78,8 @@ impl MetricsRow {
             )),
             None => s.push_str(",,,,,,,,"),
         }
-        s.push_str(if self.is_best { "1" } else { "0" });
+        s.push_str(if self.is_best { "1," } else { "0," });
+        s.push_str(&self.grad_norm.to_string());
         s
     }
 }
@@ -103,12 +108,15 @@ impl MetricsLog {
                 })
             }
         };
+        let columns = HEADER.split(',').count();
         let mut out = String::from(HEADER);
         out.push('\n');
         for line in old.lines().skip(1) {
             let epoch: Option<usize> = line.split(',').next().and_then(|e| e.parse().ok());
             if epoch.is_some_and(|e| e < row.epoch) {
                 out.push_str(line);
+                let missing = columns.saturating_sub(line.split(',').count());
+                out.push_str(&",".repeat(missing));
                 out.push('\n');
             }
         }
@@ -137,6 +145,7 @@ mod tests {
                 bend: 0.2,
             },
             train_samples: 8,
+            grad_norm: 2.5,
             validation: val.then_some(Validation {
                 terms: LossTerms::default(),
                 e_dist_cm: 1.25,
@@ -164,7 +173,24 @@ mod tests {
         assert!(lines.iter().all(|l| l.split(',').count() == cols));
         assert!(lines[1].starts_with("1,10,0.001,1.500,8,0.5,0.25,0,0.1,0.2,2,"));
         assert!(lines[2].starts_with("2,20,"));
-        assert!(lines[2].ends_with(",1.25,9.5,1"));
-        assert!(row(4, false).to_csv().ends_with(",,,,,,,,0"));
+        assert!(lines[2].ends_with(",1.25,9.5,1,2.5"));
+        assert!(row(4, false).to_csv().ends_with(",,,,,,,,0,2.5"));
+    }
+
+    #[test]
+    fn rows_of_an_older_log_get_the_new_column_empty() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.csv");
+        let old_header = HEADER.trim_end_matches(",train_grad_norm");
+        let old_row = row(1, true).to_csv();
+        let old_row = old_row.trim_end_matches(",2.5");
+        std::fs::write(&path, format!("{old_header}\n{old_row}\n")).unwrap();
+        MetricsLog::new(path.clone()).append(&row(2, true)).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines[0], HEADER);
+        assert_eq!(lines[1], format!("{old_row},"));
+        let cols = HEADER.split(',').count();
+        assert!(lines.iter().all(|l| l.split(',').count() == cols));
     }
 }

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use crate::batch::Batch;
 use crate::error::{ModelError, Result};
 use crate::garnet::GarNet;
+use crate::grad_clip::clip_gradient_norm;
 use crate::loss::{garnet_loss, LossConfig, LossTerms};
 use crate::tensors::read_points;
 use crate::topology::TopologyTensors;
@@ -50,9 +51,19 @@ impl LossConfig {
     }
 }
 
+/// What one optimisation step did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct StepReport {
+    /// Loss terms before the update.
+    pub terms: LossTerms,
+    /// L2 norm of all gradients together before clipping (loss units per parameter unit).
+    pub grad_norm: f32,
+}
+
 /// One Adam step on `batch` (which must have targets and live on an autodiff device, as
-/// `model` does): forward, loss, backward, update `model` in place. Returns the loss terms
-/// before the update. Fails (leaving `model` unchanged) when the loss is not finite.
+/// `model` does): forward, loss, backward, gradients scaled to a joint L2 norm of at most
+/// `max_grad_norm` when given (see [`crate::grad_clip`]), update `model` in place. Fails
+/// (leaving `model` unchanged) when the loss or the gradient norm is not finite.
 pub fn train_step(
     model: &mut GarNet,
     optim: &mut ModuleOptimizer,
@@ -60,7 +71,8 @@ pub fn train_step(
     topo: &TopologyTensors,
     loss_cfg: &LossConfig,
     lr: f64,
-) -> Result<LossTerms> {
+    max_grad_norm: Option<f32>,
+) -> Result<StepReport> {
     let pred = model.forward(
         batch.body_stream.clone(),
         batch.warped.clone(),
@@ -75,9 +87,15 @@ pub fn train_step(
         )));
     }
     let grads = loss.total.backward();
-    let grads = GradientsParams::from_grads(grads, &*model);
+    let mut grads = GradientsParams::from_grads(grads, &*model);
+    let grad_norm = clip_gradient_norm(&*model, &mut grads, max_grad_norm)?;
+    if !grad_norm.is_finite() {
+        return Err(ModelError::InvalidInput(format!(
+            "training diverged: the gradient norm is {grad_norm} ({terms:?})"
+        )));
+    }
     *model = optim.step(lr, model.clone(), grads);
-    Ok(terms)
+    Ok(StepReport { terms, grad_norm })
 }
 
 /// Predictions and errors of one evaluated batch.

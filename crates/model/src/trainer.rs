@@ -17,8 +17,9 @@ use crate::error::{ModelError, Result};
 use crate::garnet::GarNet;
 use crate::loss::{LossConfig, LossTerms};
 use crate::metrics_log::{MetricsLog, MetricsRow};
+use crate::schedule::CosineSchedule;
 use crate::topology::{GarmentTopology, TopologyTensors};
-use crate::train::{adam, evaluate_batch, train_step};
+use crate::train::{adam, evaluate_batch, train_step, StepReport};
 
 /// File name of the checkpoint written after every epoch.
 pub const LAST_CHECKPOINT: &str = "last.garnet";
@@ -49,6 +50,10 @@ pub struct EpochReport {
     pub train: LossTerms,
     /// Training samples seen.
     pub train_samples: usize,
+    /// Mean joint gradient norm of the epoch's steps, before clipping.
+    pub grad_norm: f32,
+    /// Learning rate of the epoch.
+    pub lr: f64,
     /// Validation results (when a validation set was given).
     pub validation: Option<Validation>,
     /// Whether this epoch gave a new best checkpoint.
@@ -176,9 +181,32 @@ impl Trainer {
         self.lr
     }
 
-    /// Sets the learning rate for the next steps.
+    /// Sets the learning rate for the next steps (a schedule, when set, overrides it at the
+    /// start of each epoch of [`Trainer::fit`]).
     pub fn set_lr(&mut self, lr: f64) {
         self.lr = lr;
+    }
+
+    /// Clips the gradients of the next steps to a joint L2 norm of `max_norm` (`None`: no
+    /// clipping); stored in the checkpoints, so a resumed run keeps it.
+    pub fn set_max_grad_norm(&mut self, max_norm: Option<f32>) -> Result<()> {
+        if max_norm.is_some_and(|m| !(m.is_finite() && m > 0.0)) {
+            return Err(ModelError::InvalidInput(format!(
+                "the gradient norm to clip at must be > 0, got {max_norm:?}"
+            )));
+        }
+        self.state.max_grad_norm = max_norm;
+        Ok(())
+    }
+
+    /// Follows `schedule` from the next epoch of [`Trainer::fit`] on (`None`: the rate stays
+    /// as set). Keeps a stored schedule with the same plan (see
+    /// [`CosineSchedule::same_plan`]), so resuming with the same command continues it.
+    pub fn set_schedule(&mut self, schedule: Option<CosineSchedule>) {
+        self.state.schedule = match (self.state.schedule, schedule) {
+            (Some(old), Some(new)) if old.same_plan(&new) => Some(old),
+            (_, new) => new,
+        };
     }
 
     /// The loss configuration.
@@ -201,42 +229,51 @@ impl Trainer {
         )
     }
 
-    /// One optimiser step on `samples` (which need targets); returns the loss terms.
-    pub fn step(&mut self, samples: &[Sample]) -> Result<LossTerms> {
+    /// One optimiser step on `samples` (which need targets); returns the loss terms and
+    /// the gradient norm.
+    pub fn step(&mut self, samples: &[Sample]) -> Result<StepReport> {
         let batch = self.train_batch(samples)?;
-        let terms = train_step(
+        let report = train_step(
             &mut self.model,
             &mut self.optim,
             &batch,
             &self.topo,
             &self.loss,
             self.lr,
+            self.state.max_grad_norm,
         )?;
         self.state.step += 1;
         self.state.lr = self.lr;
-        Ok(terms)
+        Ok(report)
     }
 
     /// One pass over `batches` (each a `Vec<Sample>` or the data source's error), one step
-    /// per batch; returns the loss terms averaged over samples and the sample count. Does not
-    /// advance the epoch counter (see [`Trainer::run_epoch`]).
-    pub fn train_epoch<I, E>(&mut self, batches: I) -> Result<(LossTerms, usize)>
+    /// per batch; returns the loss terms averaged over samples, the sample count and the
+    /// mean gradient norm over steps. Does not advance the epoch counter (see
+    /// [`Trainer::run_epoch`]).
+    pub fn train_epoch<I, E>(&mut self, batches: I) -> Result<(LossTerms, usize, f32)>
     where
         I: IntoIterator<Item = std::result::Result<Vec<Sample>, E>>,
         E: Display,
     {
         let mut sum = LossTerms::default();
-        let mut count = 0usize;
+        let (mut count, mut steps, mut norm_sum) = (0usize, 0usize, 0.0f64);
         for batch in batches {
             let samples = batch.map_err(|e| ModelError::Data(e.to_string()))?;
             if samples.is_empty() {
                 continue;
             }
-            let terms = self.step(&samples)?;
-            sum = sum + terms.scaled(samples.len() as f32);
+            let report = self.step(&samples)?;
+            sum = sum + report.terms.scaled(samples.len() as f32);
             count += samples.len();
+            steps += 1;
+            norm_sum += report.grad_norm as f64;
         }
-        Ok((sum.scaled(1.0 / count.max(1) as f32), count))
+        Ok((
+            sum.scaled(1.0 / count.max(1) as f32),
+            count,
+            (norm_sum / steps.max(1) as f64) as f32,
+        ))
     }
 
     /// Evaluates the network (without autodiff) on `batches`; averages over samples.
@@ -318,7 +355,10 @@ impl Trainer {
             path: out_dir.to_path_buf(),
             source: e,
         })?;
-        let (train_terms, train_samples) = self.train_epoch(train)?;
+        if let Some(s) = self.state.schedule {
+            self.lr = s.lr(self.state.epoch);
+        }
+        let (train_terms, train_samples, grad_norm) = self.train_epoch(train)?;
         let validation = match valid {
             Some(v) => Some(self.validate(v)?),
             None => None,
@@ -346,6 +386,7 @@ impl Trainer {
             seconds,
             train: train_terms,
             train_samples,
+            grad_norm,
             validation,
             is_best,
         };
@@ -354,6 +395,8 @@ impl Trainer {
             epoch: self.state.epoch,
             train: train_terms,
             train_samples,
+            grad_norm,
+            lr: self.lr,
             validation,
             is_best,
             seconds,

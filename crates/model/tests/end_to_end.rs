@@ -251,6 +251,7 @@ fn checkpoints_round_trip_exactly_and_resume_training() {
         &topo.to_device(&device.clone().autodiff()),
         &LossConfig::new(),
         1e-3,
+        None,
     )
     .unwrap();
     fresh.step(&data[1..]).unwrap();
@@ -316,6 +317,10 @@ fn trainer_writes_checkpoints_and_metrics_and_resumes() {
     };
     let valid = || vec![Ok::<_, String>(data[3..].to_vec())];
     let mut trainer = Trainer::new(s.clone(), LossConfig::new(), 1e-3, &device).unwrap();
+    let schedule = CosineSchedule::new(1e-3, 1e-4, 0, 3).unwrap();
+    trainer.set_schedule(Some(schedule));
+    trainer.set_max_grad_norm(Some(50.0)).unwrap();
+    assert!(trainer.set_max_grad_norm(Some(-1.0)).is_err());
     let mut seen = Vec::new();
     let reports = trainer
         .fit(
@@ -337,14 +342,29 @@ fn trainer_writes_checkpoints_and_metrics_and_resumes() {
     let text = std::fs::read_to_string(&metrics).unwrap();
     assert_eq!(text.lines().count(), 3);
     assert_eq!(trainer.state().step, 4);
+    // The schedule sets each epoch's rate; every step reports its gradient norm.
+    assert_eq!(reports[0].lr, 1e-3);
+    assert!((reports[1].lr - schedule.lr(1)).abs() < 1e-15);
+    assert!(reports.iter().all(|r| r.grad_norm > 0.0));
+    assert!(text
+        .lines()
+        .nth(1)
+        .unwrap()
+        .ends_with(&format!(",{}", reports[0].grad_norm)));
 
+    // The resumed run keeps the clipping and the schedule (a new plan of the same rates
+    // and end keeps the old start).
     let mut resumed = Trainer::resume(&last, None, &device).unwrap();
     assert_eq!(resumed.state().epoch, 2);
+    assert_eq!(resumed.state().max_grad_norm, Some(50.0));
+    resumed.set_schedule(Some(CosineSchedule::new(1e-3, 1e-4, 2, 3).unwrap()));
+    assert_eq!(resumed.state().schedule, Some(schedule));
     let more = resumed
         .fit(3, |_| train(), Some(valid), dir.path(), |_| {})
         .unwrap();
     assert_eq!(more.len(), 1);
     assert_eq!(more[0].epoch, 3);
+    assert!((more[0].lr - schedule.lr(2)).abs() < 1e-15);
     let text = std::fs::read_to_string(&metrics).unwrap();
     assert_eq!(text.lines().count(), 4);
     assert_eq!(load_checkpoint(&last).unwrap().state.epoch, 3);
@@ -358,6 +378,30 @@ fn trainer_writes_checkpoints_and_metrics_and_resumes() {
         )
         .unwrap_err();
     assert!(err.to_string().contains("shard 7 unreadable"));
+}
+
+/// Clipping the gradients to a tiny norm changes the steps after the first (Adam's first
+/// step does not see the gradient's scale) and reports the norm before clipping.
+#[test]
+fn gradient_clipping_changes_training() {
+    let device = Device::flex();
+    let s = setup(Variant::Naive, 60);
+    let data = samples(&s, 2);
+    let pairs: Vec<(&[Vec3], &[Vec3])> =
+        data.iter().map(|d| (&d.body[..], &d.warped[..])).collect();
+    let run = |clip: Option<f32>| {
+        let mut t = Trainer::new(s.clone(), LossConfig::new(), 1e-3, &device).unwrap();
+        t.set_max_grad_norm(clip).unwrap();
+        let norms: Vec<f32> = (0..3)
+            .map(|i| t.step(&data[i % 2..i % 2 + 1]).unwrap().grad_norm)
+            .collect();
+        (norms, t.draper().unwrap().drape_batch(&pairs).unwrap())
+    };
+    let (free_norms, free) = run(None);
+    let (clipped_norms, clipped) = run(Some(1e-3));
+    assert_eq!(free_norms[0], clipped_norms[0]);
+    assert!(free_norms[0] > 1e-3);
+    assert_ne!(bits(&free), bits(&clipped));
 }
 
 /// GarNet-Local with small widths fits one synthetic sample (a smooth ~3 cm drape of a
