@@ -97,11 +97,11 @@ impl LocalPool {
         let l = local.dims()[2];
         // Max over the k nearest kept points, one [B*N, L] gather per neighbour rank (no
         // [B*N*k, L] intermediate), with `maximum` (exact, the gradient to one side).
-        let table = local.reshape([1, b * s, l]);
+        let table = local.reshape([b * s, l]);
         let gathered = idx
             .knn
             .iter()
-            .map(|col| table.clone().select(1, col.clone()));
+            .map(|col| table.clone().select(0, col.clone()));
         match gathered.reduce(|acc, t| maximum(t, acc)) {
             Some(acc) => acc.reshape([b, n, l]),
             // No neighbour (knn_k = 0, refused by GarNet::translations): no local feature.

@@ -23,7 +23,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::batch::Batch;
 use crate::error::{ModelError, Result};
-use crate::tensors::{index_tensor, read_f32, read_points, vec_tensor};
+use crate::tensors::{gather_rows, index_tensor, read_f32, read_points, vec_tensor};
 use crate::topology::TopologyTensors;
 
 /// Added to squared lengths before a square root (square metres), so that the gradient of a
@@ -151,9 +151,9 @@ pub fn vertex_loss(pred: Tensor<3>, target: Tensor<3>) -> Tensor<1> {
 /// Unit face normals `[B,F,3]` of `vertices` `[B,N,3]` with the faces' corner index tensors
 /// (`[F]` each).
 pub fn face_normals(vertices: Tensor<3>, faces: &[Tensor<1, Int>; 3]) -> Tensor<3> {
-    let v0 = vertices.clone().select(1, faces[0].clone());
-    let v1 = vertices.clone().select(1, faces[1].clone());
-    let v2 = vertices.select(1, faces[2].clone());
+    let v0 = gather_rows(vertices.clone(), &faces[0]);
+    let v1 = gather_rows(vertices.clone(), &faces[1]);
+    let v2 = gather_rows(vertices, &faces[2]);
     let n = (v1 - v0.clone()).cross(v2 - v0, 2);
     let len = (n.clone().square().sum_dim(2) + SQRT_EPS).sqrt();
     n / len
@@ -168,8 +168,8 @@ pub fn normal_loss(pred: Tensor<3>, target: Tensor<3>, faces: &[Tensor<1, Int>; 
 
 /// Lengths `[B,P,1]` between the vertices of each pair (metres).
 fn pair_lengths(v: Tensor<3>, pairs: &[Tensor<1, Int>; 2]) -> Tensor<3> {
-    let a = v.clone().select(1, pairs[0].clone());
-    let b = v.select(1, pairs[1].clone());
+    let a = gather_rows(v.clone(), &pairs[0]);
+    let b = gather_rows(v, &pairs[1]);
     ((a - b).square().sum_dim(2) + SQRT_EPS).sqrt()
 }
 

@@ -21,6 +21,25 @@ pub fn vec_tensor<const D: usize>(
     Tensor::from_data(TensorData::new(values, shape), device)
 }
 
+/// The rows `idx` (`[L]`, each `< N`) of every sample of `x` `[B,N,C]`: `[B,L,C]`, the same
+/// as `x.select(1, idx)`, computed as one select over the first dimension of the `[B*N,C]`
+/// view: flex's select backward (a scatter-add) runs ~8x faster along the rows of a matrix
+/// than along the middle dimension of a 3-D tensor (0.38 against 3.1 ms forward and
+/// backward for 14000 rows of 35 features).
+pub fn gather_rows(x: Tensor<3>, idx: &Tensor<1, Int>) -> Tensor<3> {
+    let [b, n, c] = x.dims();
+    let l = idx.dims()[0];
+    let rows = if b == 1 {
+        idx.clone()
+    } else {
+        let offsets = Tensor::<1, Int>::arange(0..b as i64, &idx.device())
+            .mul_scalar(n as i64)
+            .reshape([b, 1]);
+        (offsets + idx.clone().reshape([1, l])).reshape([b * l])
+    };
+    x.reshape([b * n, c]).select(0, rows).reshape([b, l, c])
+}
+
 /// Stacks B point lists of equal length N into `[B,N,3]` (metres).
 pub fn points_tensor(samples: &[&[Vec3]], device: &Device) -> Tensor<3> {
     let b = samples.len();
@@ -64,4 +83,29 @@ pub fn read_scalar(t: Tensor<1>) -> Result<f32> {
     v.first()
         .copied()
         .ok_or_else(|| ModelError::Backend("empty tensor read as a scalar".into()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gather_rows_equals_select_with_the_same_gradient() {
+        let device = Device::flex().autodiff();
+        let idx = index_tensor([3, 0, 0, 4, 2, 3, 1], &device);
+        for b in [1, 3] {
+            let x = Tensor::<3>::random([b, 5, 4], burn::tensor::Distribution::Default, &device)
+                .require_grad();
+            let w = Tensor::<3>::random([b, 7, 4], burn::tensor::Distribution::Default, &device);
+            let ours = gather_rows(x.clone(), &idx);
+            let theirs = x.clone().select(1, idx.clone());
+            assert_eq!(
+                read_f32(ours.clone()).unwrap(),
+                read_f32(theirs.clone()).unwrap()
+            );
+            let g1 = x.grad(&(ours * w.clone()).sum().backward()).unwrap();
+            let g2 = x.grad(&(theirs * w).sum().backward()).unwrap();
+            assert_eq!(read_f32(g1).unwrap(), read_f32(g2).unwrap(), "batch {b}");
+        }
+    }
 }
