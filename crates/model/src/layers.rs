@@ -167,7 +167,7 @@ mod tests {
         check(
             lrelu(x.clone()),
             leaky_relu(x.clone(), LEAKY_SLOPE),
-            &[x.clone()],
+            std::slice::from_ref(&x),
         );
         // Every third entry of b ties with a.
         let b = Tensor::<2>::random([10, 37], burn::tensor::Distribution::Default, &device);
