@@ -113,7 +113,7 @@ fn model_card(
          - progress: {ep} epochs, {st} steps, last learning rate {lr:e}; best validation E_dist \
          {best}\n\
          - loss: L_vertex + {pen} L_pen + {norm} L_norm + {bend} L_bend, lengths in {unit}, \
-         d_tol {dtol} m\n\n",
+         d_tol {dtol} m\n{clip}{history}\n",
         ds = manifest.spec.name,
         dir = data.dataset().dir().display(),
         cmd = state
@@ -135,6 +135,17 @@ fn model_card(
             u => format!("units of 1/{u} m"),
         },
         dtol = loss.d_tol,
+        clip = state.max_grad_norm.map_or(String::new(), |n| format!(
+            "- gradients clipped to a joint L2 norm of {n} (the last run's setting)\n"
+        )),
+        history = source
+            .parent()
+            .map(|d| d.join(model::trainer::METRICS_LOG))
+            .and_then(|m| std::fs::read_to_string(m).ok())
+            .and_then(|csv| learning_rate_history(&csv))
+            .map_or(String::new(), |h| format!(
+                "- learning rate by epoch (from the run's metrics.csv): {h}\n"
+            )),
     );
     md += &format!(
         "## Test metrics ('{split}' split: bodies never seen in training)\n\n\
@@ -164,4 +175,82 @@ fn model_card(
         path.display()
     );
     Ok(md)
+}
+
+/// The learning rates of a training log (`metrics.csv` text) as segments of epochs: a
+/// constant rate as `3e-4 (epochs 1-22)`, a falling one as `1e-3 to 1e-5 (epochs 23-50)`,
+/// with the epoch that wrote the best checkpoint; `None` for a log without rows.
+fn learning_rate_history(csv: &str) -> Option<String> {
+    let rows: Vec<(usize, f64, bool)> = csv
+        .lines()
+        .skip(1)
+        .filter_map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            Some((
+                f.first()?.parse().ok()?,
+                f.get(2)?.parse().ok()?,
+                f.get(18) == Some(&"1"),
+            ))
+        })
+        .collect();
+    // (first epoch, last epoch, first rate, last rate)
+    let mut segments: Vec<(usize, usize, f64, f64)> = Vec::new();
+    for &(epoch, lr, _) in &rows {
+        match segments.last_mut() {
+            Some(s) if (lr == s.3 && s.2 == s.3) || (lr < s.3 && (s.0 == s.1 || s.3 < s.2)) => {
+                s.1 = epoch;
+                s.3 = lr;
+            }
+            _ => segments.push((epoch, epoch, lr, lr)),
+        }
+    }
+    let best = rows.iter().rev().find(|r| r.2).map(|r| r.0);
+    let text: Vec<String> = segments
+        .iter()
+        .map(|&(a, b, l0, l1)| {
+            let span = if a == b {
+                format!("epoch {a}")
+            } else {
+                format!("epochs {a}-{b}")
+            };
+            if l0 == l1 {
+                format!("{l0:.1e} ({span})")
+            } else {
+                format!("{l0:.1e} to {l1:.1e} ({span})")
+            }
+        })
+        .collect();
+    (!text.is_empty()).then(|| {
+        text.join(", ")
+            + &best.map_or(String::new(), |b| {
+                format!("; best checkpoint from epoch {b}")
+            })
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::learning_rate_history;
+
+    #[test]
+    fn learning_rates_fold_into_constant_and_falling_segments() {
+        let header = model::metrics_log::HEADER;
+        let row = |e: usize, lr: f64, best: u8| {
+            format!("{e},0,{lr},1.0,8,1,1,0,0,0,2,1,1,0,0,0,3.5,20,{best},100")
+        };
+        let mut csv = format!("{header}\n");
+        for e in 1..=3 {
+            csv += &(row(e, 3e-4, 0) + "\n");
+        }
+        for (e, lr) in [(4, 1e-3), (5, 6e-4), (6, 2e-4), (7, 1e-5)] {
+            csv += &(row(e, lr, u8::from(e == 6)) + "\n");
+        }
+        csv += &(row(8, 1e-5, 0) + "\n");
+        assert_eq!(
+            learning_rate_history(&csv).unwrap(),
+            "3.0e-4 (epochs 1-3), 1.0e-3 to 1.0e-5 (epochs 4-7), 1.0e-5 (epoch 8); \
+             best checkpoint from epoch 6"
+        );
+        assert_eq!(learning_rate_history(header), None);
+    }
 }

@@ -190,6 +190,7 @@ fn train_resume_eval_and_drape() {
         "| GarNet-local |",
         "| DQS warp (the input M) |",
         "best validation E_dist",
+        "learning rate by epoch (from the run's metrics.csv): 1.0e-3 (epochs 1-3)",
     ] {
         assert!(card.contains(needle), "{needle} missing:\n{card}");
     }
