@@ -110,7 +110,7 @@ fn model_card(
          - dataset: '{ds}' (`{dir}`, spec `{dir}/spec.toml`), {train} training samples of this \
          garment; validation on its 'val' split\n\
          - command: `{cmd}`\n\
-         - progress: {ep} epochs, {st} steps, last learning rate {lr:e}; best validation E_dist \
+         - progress: {ep} epochs, {st} steps, last learning rate {lr:.1e}; best validation E_dist \
          {best}\n\
          - loss: L_vertex + {pen} L_pen + {norm} L_norm + {bend} L_bend, lengths in {unit}, \
          d_tol {dtol} m\n{clip}{history}\n",
