@@ -6,12 +6,17 @@ use burn::prelude::*;
 
 use crate::init::{ParamInit, LEAKY_SLOPE};
 
-/// LeakyReLU with GarNet's slope 0.1, as `x * s` with the slope `s` (1 where `x >= 0`, else
-/// 0.1) computed outside the graph: the same values and gradients as burn's `leaky_relu`
-/// (slope 1 at 0 included), whose flex
-/// backward (a masked select) took 61 ms forward and backward on a `[1,3345,512]` tensor
-/// against 1.9 ms for this (2 loaded cores).
+/// LeakyReLU with GarNet's slope 0.1. On a tensor tracked by autodiff, as `x * s` with the
+/// slope `s` (1 where `x >= 0`, else 0.1) computed outside the graph: the same values and
+/// gradients as burn's `leaky_relu` (slope 1 at 0 included), whose flex backward (a masked
+/// select) took 61 ms forward and backward on a `[1,3345,512]` tensor against 1.9 ms for
+/// this (2 loaded cores). Without gradients burn's own single-pass `leaky_relu` is faster
+/// (the product form made a 1.4k-vertex GarNet-Local drape ~40% slower). Untracked tensors
+/// (inference) take that path.
 pub fn lrelu<const D: usize>(x: Tensor<D>) -> Tensor<D> {
+    if !x.is_tracked() {
+        return burn::tensor::activation::leaky_relu(x, LEAKY_SLOPE);
+    }
     let slope =
         x.clone().detach().greater_equal_elem(0.0).float() * (1.0 - LEAKY_SLOPE) + LEAKY_SLOPE;
     x * slope
@@ -20,8 +25,12 @@ pub fn lrelu<const D: usize>(x: Tensor<D>) -> Tensor<D> {
 /// Element-wise maximum of `a` and `b` (same shape) as `a m + b (1 - m)`, `m = [a > b]`
 /// computed outside the graph: exact for finite inputs, the gradient to exactly one side
 /// (to `b` on ties), and a product instead of flex's masked select (`max_pair`: 67 ms
-/// forward and backward on a `[1,3345,512]` pair, this a few ms).
+/// forward and backward on a `[1,3345,512]` pair, this a few ms). Without gradients,
+/// `max_pair` itself.
 pub fn maximum<const D: usize>(a: Tensor<D>, b: Tensor<D>) -> Tensor<D> {
+    if !a.is_tracked() && !b.is_tracked() {
+        return a.max_pair(b);
+    }
     let m = a.clone().detach().greater(b.clone().detach()).float();
     let rest = m.clone().neg() + 1.0;
     a * m + b * rest
@@ -168,6 +177,16 @@ mod tests {
             lrelu(x.clone()),
             leaky_relu(x.clone(), LEAKY_SLOPE),
             std::slice::from_ref(&x),
+        );
+        // Without gradients: the same values (the plain path).
+        let plain = x.clone().inner();
+        assert_eq!(
+            read_f32(lrelu(plain.clone())).unwrap(),
+            read_f32(leaky_relu(plain.clone(), LEAKY_SLOPE)).unwrap()
+        );
+        assert_eq!(
+            read_f32(maximum(plain.clone(), plain.clone() * 0.5)).unwrap(),
+            read_f32(plain.clone().max_pair(plain * 0.5)).unwrap()
         );
         // Every third entry of b ties with a.
         let b = Tensor::<2>::random([10, 37], burn::tensor::Distribution::Default, &device);
