@@ -38,6 +38,8 @@ pub struct Chart {
 const INK: [u8; 3] = [40, 40, 40];
 const GRID: [u8; 3] = [225, 225, 225];
 const PAPER: [u8; 3] = [255, 255, 255];
+/// Legend width beyond its longest name: the colour swatch, the gap and a margin (pixels).
+const LEGEND_PAD: i64 = 30;
 
 impl Chart {
     /// Draws `series` into a new image.
@@ -95,13 +97,25 @@ impl Chart {
             INK,
         );
         draw_text(&mut img, 4, top - 14, &self.y_label, 1, INK);
-        for (i, s) in series.iter().enumerate() {
+        for s in series {
             for pair in s.points.windows(2) {
                 let (a, b) = (to_px(pair[0].0, pair[0].1), to_px(pair[1].0, pair[1].1));
                 line(&mut img, a, b, s.color);
             }
+        }
+        // The legend on a paper box in the top right corner, as wide as its longest name.
+        let name_w = series
+            .iter()
+            .map(|s| text_size(&s.name, 1).0 as i64)
+            .max()
+            .unwrap_or(0);
+        let x = (left + pw - name_w - LEGEND_PAD).max(left + 4);
+        if !series.is_empty() {
+            let box_h = 14 * series.len() as u32 + 6;
+            img.fill_rect(x - 4, top + 6, (name_w + LEGEND_PAD) as u32, box_h, PAPER);
+        }
+        for (i, s) in series.iter().enumerate() {
             let y = top + 10 + 14 * i as i64;
-            let x = left + pw - 150;
             img.fill_rect(x, y + 3, 16, 3, s.color);
             draw_text(&mut img, x + 22, y, &s.name, 1, INK);
         }
@@ -145,5 +159,39 @@ mod tests {
         assert_eq!(img.pixel(175, 93), red);
         assert_ne!(img.pixel(90, 50), red);
         assert!(img.count_not(PAPER) > 500);
+    }
+
+    /// Regression: names were drawn from a fixed 150 px before the right edge, so
+    /// "tshirt GarNet-global" ran off the plot.
+    #[test]
+    fn a_long_legend_name_stays_inside_the_plot() {
+        let chart = Chart {
+            title: "t".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            x_range: (0.0, 1.0),
+            y_range: (0.0, 1.0),
+            ticks: 4,
+            size: (400, 200),
+        };
+        let name = "sweater GarNet-global and more";
+        let img = chart.draw(&[Series {
+            name: name.into(),
+            color: [0, 0, 255],
+            points: vec![],
+        }]);
+        let (tw, th) = text_size(name, 1);
+        // The plot's right edge is x = 380; the text ends left of it.
+        let right = 380i64;
+        let ink_beyond = (right..400)
+            .flat_map(|x| (36..36 + 20 + th as i64).map(move |y| (x, y)))
+            .filter(|&(x, y)| img.pixel(x as u32, y as u32) == INK)
+            .count();
+        assert_eq!(ink_beyond, 0);
+        // And it is drawn: ink of the text width lies in the legend row.
+        let ink_row = (0..400)
+            .filter(|&x| (46..46 + th as i64).any(|y| img.pixel(x, y as u32) == INK))
+            .count();
+        assert!(ink_row as u32 > tw / 3, "{ink_row} of {tw}");
     }
 }
