@@ -198,6 +198,7 @@ pub fn drape(
             break;
         }
     }
+    sim.project_out_of(&collider);
     let mut stats = DrapeStats {
         animation_steps,
         settle_steps: step - animation_steps,

@@ -25,7 +25,7 @@ use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 use crate::cloth::{ClothSim, StepInfo, MAX_SPEED};
-use crate::collide::BodyCollider;
+use crate::collide::{BodyCollider, SurfaceHit};
 use crate::error::{Result, SimError};
 use crate::pd::{Contact, PdProblem, MIN_PAR};
 
@@ -211,6 +211,34 @@ impl ClothSim {
     }
 }
 
+impl ClothSim {
+    /// Moves every free vertex inside the body, or closer to it than half the thickness, out
+    /// of it as the projection after each step does, but with the exact inside test for every
+    /// vertex (the steps run it every [`FULL_INSIDE_CHECK`] steps) and without a time step:
+    /// the moved vertices stop. For the end of a simulation, so that no vertex a step's
+    /// bounded search missed is left inside. Returns how many vertices moved.
+    pub fn project_out_of(&mut self, collider: &BodyCollider) -> usize {
+        let thick = self.params.thickness.max(collider.thickness());
+        let reach = thick + self.params.contact_margin;
+        let dist0 = vec![0.0; self.x.len()];
+        let x = self.x.clone();
+        let fixes = project_out(
+            self,
+            collider,
+            &x,
+            &dist0,
+            reach,
+            thick * PROJECT_FRACTION,
+            true,
+        );
+        for &(i, target, _) in &fixes {
+            self.x[i] = target;
+            self.v[i] = Vec3::ZERO;
+        }
+        fixes.len()
+    }
+}
+
 /// Fills `contacts` (`[N]`) for the free vertices of `sim` within `reach` of the body at the
 /// start of the step, and `dist0` (`[N]`) with a lower bound of every free vertex's distance
 /// to the body then (searched up to about twice the distance it can travel this step).
@@ -296,9 +324,46 @@ fn project_out(
             if hit.signed >= to {
                 return None;
             }
-            Some((i, hit.point + hit.out * to, hit.out))
+            // Under the closest surface yet outside the body: a fold of the skin (a posed
+            // crease passing through itself). Pushing out of that surface would push the
+            // vertex into the fold's other side; the winding test is the judge.
+            if hit.signed < 0.0 && !c.contains_cur(xi) {
+                return None;
+            }
+            Some(clear_of_overlaps(c, i, hit, reach, to))
         })
         .collect()
+}
+
+/// Most projections of one vertex in a step: where two body parts overlap (an arm
+/// sunk into the chest), the point moved out of the closest surface can land inside the
+/// other part; projecting again onto whichever surface is then closest walks it out of
+/// both, as alternating projections onto two half-spaces reach their intersection.
+const MAX_PROJECTIONS: usize = 4;
+
+/// Vertex `i` moved `to` metres outside the surface of `hit` (the closest to it) and then,
+/// while that lands it inside the body (under the surface then closest, within `reach`,
+/// and inside by the winding test), outside that surface too:
+/// `(i, target, outward direction of the last projection)`.
+fn clear_of_overlaps(
+    c: &BodyCollider,
+    i: usize,
+    hit: SurfaceHit,
+    reach: f32,
+    to: f32,
+) -> (usize, Vec3, Vec3) {
+    let mut target = hit.point + hit.out * to;
+    let mut out = hit.out;
+    for _ in 1..MAX_PROJECTIONS {
+        match c.surface_within(target, reach) {
+            Some(h) if h.signed < 0.0 && c.contains_cur(target) => {
+                target = h.point + h.out * to;
+                out = h.out;
+            }
+            _ => break,
+        }
+    }
+    (i, target, out)
 }
 
 /// Coulomb friction: reduces the tangential part of `vrel` (relative to the surface with unit

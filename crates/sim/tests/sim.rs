@@ -119,6 +119,51 @@ fn cloth_dropped_on_a_sphere_rests_outside_it() {
     );
 }
 
+/// Where two body parts overlap (two spheres here, as an arm sunk into the chest), a cloth
+/// vertex pushed out of the nearer surface lands inside the other part; the projection
+/// walks it out of both, and the exact pass at the end of a drape finds it.
+#[test]
+fn projection_clears_a_vertex_caught_where_two_parts_overlap() {
+    let r = 0.2;
+    let centre_b = Vec3::new(0.3, 0.0, 0.0);
+    let mut body = TriMesh::icosphere(5, r);
+    let mut b = TriMesh::icosphere(5, r);
+    b.vertices.iter_mut().for_each(|v| *v += centre_b);
+    body.append(&b).unwrap();
+    // Near the crease of the lens: 1.2 mm inside A, 0.5 mm inside B.
+    let p = Vec3::new(0.1495, 0.131, 0.0);
+    let (depth_a, depth_b) = (r - p.length(), r - p.distance(centre_b));
+    assert!(depth_b > 0.0 && depth_b < depth_a, "{depth_a} {depth_b}");
+    let params = ClothParams::default();
+    let to = 0.5 * params.thickness;
+    let once = p + (p - centre_b).normalize() * (depth_b + to);
+    assert!(
+        once.length() < r - 1e-3,
+        "a single projection would clear it"
+    );
+    let cloth = TriMesh {
+        vertices: vec![
+            p,
+            p + Vec3::new(0.0, 0.05, 0.0),
+            p + Vec3::new(0.0, 0.05, 0.05),
+        ],
+        faces: vec![[0, 1, 2]],
+    };
+    let mut sim = ClothSim::new(&cloth, &params).unwrap();
+    let collider = BodyCollider::new(&body, params.thickness).unwrap();
+    assert!(collider.penetration_depths(&[p])[0] > 0.0);
+    assert_eq!(sim.project_out_of(&collider), 1);
+    let x = sim.positions()[0];
+    assert_eq!(collider.penetration_depths(&[x]), vec![0.0], "{x}");
+    // Outside both spheres (their faceted meshes lie within 0.02 mm inside them).
+    assert!(
+        x.length() > r - 2e-5 && x.distance(centre_b) > r - 2e-5,
+        "{x}"
+    );
+    assert!(x.distance(p) < 0.01, "moved {} m", x.distance(p));
+    assert_eq!(sim.positions()[1], cloth.vertices[1]);
+}
+
 /// Without gravity, damping or a body, a perturbed cloth's total energy (kinetic + elastic)
 /// does not grow: no step adds more than 0.1% of the initial energy, and it decays.
 #[test]
