@@ -62,10 +62,7 @@ impl ClothSim {
         let mut info = StepInfo::default();
 
         // 1. Contacts at the start of the step.
-        let thick = p
-            .thickness
-            .max(collider.as_ref().map_or(0.0, |c| c.thickness()));
-        let reach = thick + p.contact_margin;
+        let (thick, reach) = self.thickness_and_reach(collider.as_deref());
         let mut contacts: Vec<Option<Contact>> = vec![None; n];
         // Lower bound of each vertex's distance to the body at the start (metres).
         let mut dist0 = vec![f32::INFINITY; n];
@@ -209,17 +206,24 @@ impl ClothSim {
         info.max_speed = max_speed2.sqrt();
         Ok(info)
     }
-}
 
-impl ClothSim {
+    /// The collision thickness of a step (the larger of the cloth's and the collider's) and
+    /// the reach within which a vertex touches the body (thickness + contact margin), metres.
+    fn thickness_and_reach(&self, collider: Option<&BodyCollider>) -> (f32, f32) {
+        let thick = self
+            .params
+            .thickness
+            .max(collider.map_or(0.0, |c| c.thickness()));
+        (thick, thick + self.params.contact_margin)
+    }
+
     /// Moves every free vertex inside the body, or closer to it than half the thickness, out
     /// of it as the projection after each step does, but with the exact inside test for every
     /// vertex (the steps run it every [`FULL_INSIDE_CHECK`] steps) and without a time step:
     /// the moved vertices stop. For the end of a simulation, so that no vertex a step's
     /// bounded search missed is left inside. Returns how many vertices moved.
     pub fn project_out_of(&mut self, collider: &BodyCollider) -> usize {
-        let thick = self.params.thickness.max(collider.thickness());
-        let reach = thick + self.params.contact_margin;
+        let (thick, reach) = self.thickness_and_reach(Some(collider));
         let dist0 = vec![0.0; self.x.len()];
         let x = self.x.clone();
         let fixes = project_out(
