@@ -169,13 +169,13 @@ fn short(what: &str) -> String {
 /// A Markdown table of the cases and a summary line.
 fn markdown(cases: &[Case]) -> String {
     let mut out = String::from(
-        "| garment | shape | pose | time (s) | steps | at rest | max pen. (mm) | strain p99 (%) | limbs turned (deg) |\n|---|---|---|---:|---:|---|---:|---:|---:|\n",
+        "| garment | shape | pose | time (s) | steps | at rest | max pen. (mm) | strain p99 (%) | limbs turned (deg) | walked out |\n|---|---|---|---:|---:|---|---:|---:|---:|---:|\n",
     );
     for c in cases {
         match &c.stats {
             Some(s) => {
                 out += &format!(
-                    "| {} | {} | {} | {:.2} | {} | {} | {:.2} | {:.2} | {:.0} |\n",
+                    "| {} | {} | {} | {:.2} | {} | {} | {:.2} | {:.2} | {:.0} | {} |\n",
                     c.garment,
                     c.shape_seed,
                     c.pose,
@@ -184,12 +184,13 @@ fn markdown(cases: &[Case]) -> String {
                     if s.converged { "yes" } else { "no" },
                     s.max_penetration_m * 1e3,
                     s.strain_p99 * 100.0,
-                    s.limb_turn_deg
+                    s.limb_turn_deg,
+                    s.walked_out
                 )
             }
             None => {
                 out += &format!(
-                    "| {} | {} | {} | failed: {} | | | | | |\n",
+                    "| {} | {} | {} | failed: {} | | | | | | |\n",
                     c.garment,
                     c.shape_seed,
                     c.pose,
@@ -201,10 +202,13 @@ fn markdown(cases: &[Case]) -> String {
     let ok: Vec<&DrapeStats> = cases.iter().filter_map(|c| c.stats.as_ref()).collect();
     let worst = |f: fn(&DrapeStats) -> f32| ok.iter().map(|s| f(s)).fold(0.0, f32::max);
     out += &format!(
-        "\n{} of {} drapes succeeded, {} at rest; worst max penetration {:.2} mm, worst strain p99 {:.2}%, mean time {:.2} s\n",
+        "\n{} of {} drapes succeeded, {} at rest, {} of them with strain p99 under 2%; worst max penetration {:.2} mm, worst strain p99 {:.2}%, mean time {:.2} s\n",
         ok.len(),
         cases.len(),
         ok.iter().filter(|s| s.converged).count(),
+        ok.iter()
+            .filter(|s| s.converged && s.strain_p99 < 0.02)
+            .count(),
         worst(|s| s.max_penetration_m) * 1e3,
         worst(|s| s.strain_p99) * 100.0,
         ok.iter().map(|s| s.wall_time_s).sum::<f64>() / ok.len().max(1) as f64

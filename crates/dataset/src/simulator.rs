@@ -28,6 +28,7 @@ impl SimulatorSpec {
         c.iterations = self.iterations.unwrap_or(c.iterations);
         o.morph_steps = self.morph_steps.unwrap_or(o.morph_steps);
         o.pose_steps = self.pose_steps.unwrap_or(o.pose_steps);
+        set(&mut o.body_step, self.body_step);
         o.max_settle_steps = self.max_settle_steps.unwrap_or(o.max_settle_steps);
         set(&mut o.rest_speed, self.rest_speed);
         set(&mut o.explode_speed, self.explode_speed);
@@ -70,6 +71,12 @@ impl SimulatorSpec {
                 return Err((name.into(), format!("must be positive and finite, got {v}")));
             }
         }
+        if !(o.body_step.is_finite() && o.body_step >= 0.0) {
+            return Err((
+                "body_step".into(),
+                format!("must be non-negative metres, got {}", o.body_step),
+            ));
+        }
         if !(o.max_penetration.is_finite() && o.max_penetration >= 0.0) {
             return Err((
                 "max_penetration".into(),
@@ -104,6 +111,16 @@ mod tests {
             ..Default::default()
         };
         assert_eq!(bad.drape_options().unwrap_err().0, "density");
+        let bad = SimulatorSpec {
+            body_step: Some(f32::NAN),
+            ..Default::default()
+        };
+        assert_eq!(bad.drape_options().unwrap_err().0, "body_step");
+        let full = SimulatorSpec {
+            body_step: Some(0.0),
+            ..Default::default()
+        };
+        assert_eq!(full.drape_options().unwrap().body_step, 0.0);
         let bad = SimulatorSpec {
             iterations: Some(0),
             ..Default::default()

@@ -228,6 +228,9 @@ pub struct SimulatorSpec {
     pub morph_steps: Option<u32>,
     /// Steps of the move into the pose.
     pub pose_steps: Option<u32>,
+    /// Most distance a body vertex travels in one animation step, metres (0: always the
+    /// full step counts).
+    pub body_step: Option<f32>,
     /// Most settling steps.
     pub max_settle_steps: Option<u32>,
     /// Root-mean-square speed at rest, m/s.

@@ -19,6 +19,9 @@ use rayon::prelude::*;
 
 use crate::error::{check_finite, Result, SimError};
 
+/// Directions [`BodyCollider::exit_point`] tries.
+const EXIT_DIRECTIONS: usize = 32;
+
 /// A closed body mesh moving over time, for cloth collision.
 #[derive(Clone, Debug)]
 pub struct BodyCollider {
@@ -271,6 +274,35 @@ impl BodyCollider {
     /// far from the surface).
     pub(crate) fn contains_cur(&self, p: Vec3) -> bool {
         self.bvh_cur.contains(p)
+    }
+
+    /// The nearest way out of the body at the end of the step from `p`, for a point the
+    /// closest surface cannot lead out (inside one body part and under the surface of
+    /// another, or under a fold of skin): along each of [`EXIT_DIRECTIONS`] directions the
+    /// point where no body part encloses the ray any more ([`Bvh::ray_exit`]), `margin`
+    /// metres beyond it, kept if the winding test finds it outside; the shortest of those.
+    /// `(target, direction)`, or `None` when no direction leads out.
+    pub(crate) fn exit_point(&self, p: Vec3, margin: f32) -> Option<(Vec3, Vec3)> {
+        let n = EXIT_DIRECTIONS as f32;
+        let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+        let mut best: Option<(f32, Vec3)> = None;
+        for k in 0..EXIT_DIRECTIONS {
+            // Fibonacci sphere: directions spread evenly over all of space.
+            let y = 1.0 - (2 * k + 1) as f32 / n;
+            let r = (1.0 - y * y).sqrt();
+            let a = golden * k as f32;
+            let dir = Vec3::new(r * a.cos(), y, r * a.sin());
+            let Some(t) = self.bvh_cur.ray_exit(p, dir) else {
+                continue;
+            };
+            if best.is_some_and(|(b, _)| b <= t) {
+                continue;
+            }
+            if !self.bvh_cur.contains(p + dir * (t + margin)) {
+                best = Some((t, dir));
+            }
+        }
+        best.map(|(t, dir)| (p + dir * (t + margin), dir))
     }
 
     fn update_normals(&mut self) {

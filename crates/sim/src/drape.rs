@@ -25,10 +25,15 @@ use crate::{BodyCollider, ClothParams, ClothSim, SimError};
 pub struct DrapeOptions {
     /// The cloth material and solver settings.
     pub cloth: ClothParams,
-    /// Steps over which the body morphs from the template shape to the target shape.
+    /// Most steps over which the body morphs from the template shape to the target shape.
     pub morph_steps: u32,
-    /// Steps over which the body moves from the rest pose to the target pose.
+    /// Most steps over which the body moves from the rest pose to the target pose.
     pub pose_steps: u32,
+    /// Most distance a body vertex travels in one animation step, metres: each phase takes
+    /// as few steps as keep its fastest vertex under it (at most the phase's step count
+    /// above), so a small change of shape or pose is animated in few steps. 0 (or less)
+    /// always uses the full step counts.
+    pub body_step: f32,
     /// Most steps spent settling after the animation.
     pub max_settle_steps: u32,
     /// The cloth is at rest when its root-mean-square speed falls below this, m/s.
@@ -56,6 +61,7 @@ impl Default for DrapeOptions {
             cloth: ClothParams::default(),
             morph_steps: 40,
             pose_steps: 60,
+            body_step: 0.008,
             max_settle_steps: 400,
             rest_speed: 0.005,
             explode_speed: 30.0,
@@ -167,26 +173,32 @@ pub fn drape(
         Ok(())
     };
     // Shape: the body's rest mesh morphs linearly from the template shape to the target's.
-    for k in 1..=opts.morph_steps {
-        let t = k as f32 / opts.morph_steps as f32;
-        let body: Vec<Vec3> = template_body
+    let morphed = |t: f32| -> Result<Vec<Vec3>, SimError> {
+        Ok(template_body
             .mesh
             .vertices
             .iter()
             .zip(&target.mesh.vertices)
             .map(|(a, b)| a.lerp(*b, t))
-            .collect();
+            .collect())
+    };
+    let morph_steps = phase_steps(opts.morph_steps, opts.body_step, 1, &morphed)?;
+    for k in 1..=morph_steps {
+        let body = morphed(k as f32 / morph_steps as f32)?;
         advance(&mut sim, &mut collider, &body, &mut step)?;
     }
     // Pose: every joint slerps from rest to the target (root yaw left out).
     let rest = Pose::identity(target.rig.len());
-    let mut body = target.mesh.vertices.clone();
-    for k in 1..=opts.pose_steps {
-        let t = k as f32 / opts.pose_steps as f32;
-        body = target
+    let posed = |t: f32| -> Result<Vec<Vec3>, SimError> {
+        Ok(target
             .posed(&rest.slerp(&calm, t), opts.skinning)
             .map_err(|e| SimError::InvalidInput(e.to_string()))?
-            .vertices;
+            .vertices)
+    };
+    let pose_steps = phase_steps(opts.pose_steps, opts.body_step, POSE_PATH_SAMPLES, &posed)?;
+    let mut body = target.mesh.vertices.clone();
+    for k in 1..=pose_steps {
+        body = posed(k as f32 / pose_steps as f32)?;
         advance(&mut sim, &mut collider, &body, &mut step)?;
     }
     let animation_steps = step;
@@ -198,8 +210,9 @@ pub fn drape(
             break;
         }
     }
-    sim.project_out_of(&collider);
+    let (_, walked_out) = sim.project_out_of(&collider);
     let mut stats = DrapeStats {
+        walked_out: walked_out as u32,
         animation_steps,
         settle_steps: step - animation_steps,
         final_kinetic_energy: sim.kinetic_energy(),
@@ -236,6 +249,36 @@ pub fn drape(
     })
 }
 
+/// Points at which the pose phase's path is sampled to measure how far its vertices travel
+/// (joints slerp, so vertices move on arcs; 8 chords are within 0.5% of a half-turn arc).
+const POSE_PATH_SAMPLES: u32 = 8;
+
+/// Steps of an animation phase whose body is `at(t)` (`[V]` metres, `t` in `[0, 1]`): the
+/// fewest that keep every vertex's travel per step, measured along the path through
+/// `samples` equal chords, at most `step_len` metres; at least 1 and at most `max_steps`
+/// (which a non-positive or non-finite `step_len` always gives).
+fn phase_steps(
+    max_steps: u32,
+    step_len: f32,
+    samples: u32,
+    at: &dyn Fn(f32) -> Result<Vec<Vec3>, SimError>,
+) -> Result<u32, SimError> {
+    if !step_len.is_finite() || step_len <= 0.0 || max_steps <= 1 {
+        return Ok(max_steps);
+    }
+    let mut prev = at(0.0)?;
+    let mut travel = vec![0.0f32; prev.len()];
+    for k in 1..=samples {
+        let next = at(k as f32 / samples as f32)?;
+        for ((d, a), b) in travel.iter_mut().zip(&prev).zip(&next) {
+            *d += a.distance(*b);
+        }
+        prev = next;
+    }
+    let longest = travel.into_iter().fold(0.0f32, f32::max);
+    Ok(((longest / step_len).ceil() as u32).clamp(1, max_steps))
+}
+
 /// The root's yaw and `pose` with the root's world rotation reduced to its tilt.
 fn remove_root_yaw(target: &ShapedBody, pose: &Pose) -> (Quat, Pose) {
     let root = &target.rig.bones[0];
@@ -257,6 +300,28 @@ fn cloth_mass(mesh: &TriMesh, density: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn phase_steps_keep_the_fastest_vertex_under_the_step_length() {
+        // A vertex moving 0.1 m in a straight line, another on a half circle of radius 0.1 m
+        // (path 0.314 m, chord 0.2 m).
+        let at = |t: f32| -> Result<Vec<Vec3>, SimError> {
+            let a = std::f32::consts::PI * t;
+            Ok(vec![
+                Vec3::new(0.1 * t, 0.0, 0.0),
+                Vec3::new(0.1 * a.cos(), 0.1 * a.sin(), 0.0),
+            ])
+        };
+        // Measured along 8 chords: 0.3136 m, so 40 steps of 8 mm.
+        assert_eq!(phase_steps(60, 0.008, 8, &at).unwrap(), 40);
+        // One chord sees only 0.2 m.
+        assert_eq!(phase_steps(60, 0.008, 1, &at).unwrap(), 25);
+        assert_eq!(phase_steps(30, 0.008, 8, &at).unwrap(), 30);
+        assert_eq!(phase_steps(30, 0.0, 8, &at).unwrap(), 30);
+        assert_eq!(phase_steps(30, f32::NAN, 8, &at).unwrap(), 30);
+        let still = |_: f32| -> Result<Vec<Vec3>, SimError> { Ok(vec![Vec3::ONE]) };
+        assert_eq!(phase_steps(30, 0.008, 8, &still).unwrap(), 1);
+    }
 
     #[test]
     fn yaw_split_recomposes_and_is_vertical() {

@@ -31,6 +31,12 @@ pub struct DrapeStats {
     /// The largest turn of a limb joint by the clearance correction of the pose, degrees.
     #[serde(default)]
     pub limb_turn_deg: f32,
+    /// Garment vertices that the exact pass after the last step found inside the body with
+    /// no way out through their closest surface (caught between overlapping body parts or
+    /// under a fold of skin) and walked out the shortest way
+    /// ([`crate::ClothSim::project_out_of`]); each leaves a spike in the cloth.
+    #[serde(default)]
+    pub walked_out: u32,
 }
 
 /// The value at quantile `q` in [0, 1] of `values` (nearest rank; 0 for none).
@@ -71,7 +77,10 @@ impl DrapeStats {
             self.strain_p99 * 100.0,
             self.strain_max * 100.0,
             self.limb_turn_deg
-        )
+        ) + &match self.walked_out {
+            0 => String::new(),
+            n => format!(", {n} vertices walked out of the body"),
+        }
     }
 }
 

@@ -156,10 +156,20 @@ impl ClothSim {
 
         // 6. Collision projection.
         if let Some(c) = collider.as_deref() {
-            let full = self.steps_taken % FULL_INSIDE_CHECK == 0;
-            let fixes = project_out(self, c, &x1, &dist0, reach, thick * PROJECT_FRACTION, full);
+            let check = if self.steps_taken % FULL_INSIDE_CHECK == 0 {
+                Check::Full
+            } else {
+                Check::Near
+            };
+            let fixes = project_out(self, c, &x1, &dist0, reach, thick * PROJECT_FRACTION, check);
             info.projected = fixes.len();
-            for (i, target, nrm) in fixes {
+            for Fix {
+                i,
+                target,
+                out: nrm,
+                ..
+            } in fixes
+            {
                 let push = (target - x1[i]).length();
                 x1[i] = target;
                 let u = contacts[i].map_or(Vec3::ZERO, |c| (c.carry / h).as_vec3());
@@ -220,9 +230,12 @@ impl ClothSim {
     /// Moves every free vertex inside the body, or closer to it than half the thickness, out
     /// of it as the projection after each step does, but with the exact inside test for every
     /// vertex (the steps run it every [`FULL_INSIDE_CHECK`] steps) and without a time step:
-    /// the moved vertices stop. For the end of a simulation, so that no vertex a step's
-    /// bounded search missed is left inside. Returns how many vertices moved.
-    pub fn project_out_of(&mut self, collider: &BodyCollider) -> usize {
+    /// the moved vertices stop. A vertex still inside after that (caught where two body
+    /// parts overlap, or under a fold of skin, where the closest surface leads no way out)
+    /// goes the shortest way out of the body ([`BodyCollider::exit_point`]). For the end of
+    /// a simulation, so that no vertex is left inside. Returns how many vertices moved and
+    /// how many of them went the shortest way out.
+    pub fn project_out_of(&mut self, collider: &BodyCollider) -> (usize, usize) {
         let (thick, reach) = self.thickness_and_reach(Some(collider));
         let dist0 = vec![0.0; self.x.len()];
         let x = self.x.clone();
@@ -233,13 +246,13 @@ impl ClothSim {
             &dist0,
             reach,
             thick * PROJECT_FRACTION,
-            true,
+            Check::Exact,
         );
-        for &(i, target, _) in &fixes {
-            self.x[i] = target;
-            self.v[i] = Vec3::ZERO;
+        for f in &fixes {
+            self.x[f.i] = f.target;
+            self.v[f.i] = Vec3::ZERO;
         }
-        fixes.len()
+        (fixes.len(), fixes.iter().filter(|f| f.walked_out).count())
     }
 }
 
@@ -286,11 +299,35 @@ fn find_contacts(
         });
 }
 
+/// How thoroughly [`project_out`] looks for vertices inside the body.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Check {
+    /// Vertices with no surface within the reach are outside unless they may have travelled
+    /// farther than their start distance, when the winding test decides.
+    Near,
+    /// The winding test decides for every vertex with no surface within the reach.
+    Full,
+    /// As `Full`, and every vertex's final place is checked by the winding test: one still
+    /// inside goes the shortest way out instead.
+    Exact,
+}
+
+/// A vertex moved out of the body by [`project_out`].
+struct Fix {
+    /// The vertex.
+    i: usize,
+    /// Where it goes, metres.
+    target: Vec3,
+    /// Unit direction it was moved out along.
+    out: Vec3,
+    /// Whether it went the shortest way out of the body ([`BodyCollider::exit_point`]).
+    walked_out: bool,
+}
+
 /// The free vertices of `x1` (`[N]`) inside the body or closer to it than `to` (metres) at the
 /// end of the step, each with where it goes (`to` outside the surface) and the outward
-/// direction. Vertices with no surface within `reach` are outside unless they may have
-/// travelled farther than their start distance `dist0`, when the winding test decides;
-/// with `full`, the winding test decides for every vertex with no surface within `reach`.
+/// direction, found as thoroughly as `check` says (`dist0`: `[N]` lower bounds of the
+/// distances at the start of the step).
 fn project_out(
     sim: &ClothSim,
     c: &BodyCollider,
@@ -298,9 +335,15 @@ fn project_out(
     dist0: &[f32],
     reach: f32,
     to: f32,
-    full: bool,
-) -> Vec<(usize, Vec3, Vec3)> {
-    let max_disp = c.max_displacement();
+    check: Check,
+) -> Vec<Fix> {
+    let proj = Projection {
+        c,
+        reach,
+        to,
+        max_disp: c.max_displacement(),
+        full: check != Check::Near,
+    };
     let (x0, pinned) = (&sim.x, &sim.pinned);
     (0..x1.len())
         .into_par_iter()
@@ -310,35 +353,73 @@ fn project_out(
                 return None;
             }
             let xi = x1[i];
-            let travel = (xi - x0[i]).length() + max_disp;
-            // Far from the body at the start and not moved enough to reach it: no query
-            // (the distance at the end is at least the start distance minus the travel).
-            if !full && dist0[i] - travel > reach {
-                return None;
-            }
-            let hit = match c.surface_within(xi, reach) {
-                Some(hit) => hit,
-                None => {
-                    if (!full && travel < dist0[i]) || !c.contains_cur(xi) {
-                        return None;
-                    }
-                    c.surface_any(xi)?
+            let fix = proj.vertex(xi, x0[i], dist0[i]);
+            if check == Check::Exact && c.contains_cur(fix.map_or(xi, |f| f.0)) {
+                if let Some((target, out)) = c.exit_point(xi, to) {
+                    return Some(Fix {
+                        i,
+                        target,
+                        out,
+                        walked_out: true,
+                    });
                 }
-            };
-            if hit.signed >= to {
-                return None;
             }
-            // Under the closest surface yet outside the body: a fold of the skin (a posed
-            // crease passing through itself). Pushing out of that surface would push the
-            // vertex into the fold's other side; the winding test is the judge. It costs
-            // three ray casts, so only the full checks ask it (one per step cost 7-15% of
-            // the 1 cm T-shirt's drape time); the exact pass at the end is one of them.
-            if full && hit.signed < 0.0 && !c.contains_cur(xi) {
-                return None;
-            }
-            Some(clear_of_overlaps(c, i, hit, reach, to))
+            fix.map(|(target, out)| Fix {
+                i,
+                target,
+                out,
+                walked_out: false,
+            })
         })
         .collect()
+}
+
+/// What the projection of one vertex reads.
+struct Projection<'a> {
+    c: &'a BodyCollider,
+    /// Thickness + contact margin, metres.
+    reach: f32,
+    /// Distance outside the surface a projected vertex goes to, metres.
+    to: f32,
+    /// The body's largest displacement this step, metres.
+    max_disp: f32,
+    /// The winding test decides for every vertex with no surface within `reach`.
+    full: bool,
+}
+
+impl Projection<'_> {
+    /// Where a vertex at `xi` that started the step at `x0`, at least `dist0` metres from
+    /// the body, goes and the outward direction; `None` when it is outside and clear.
+    fn vertex(&self, xi: Vec3, x0: Vec3, dist0: f32) -> Option<(Vec3, Vec3)> {
+        let (c, reach, full) = (self.c, self.reach, self.full);
+        let travel = (xi - x0).length() + self.max_disp;
+        // Far from the body at the start and not moved enough to reach it: no query
+        // (the distance at the end is at least the start distance minus the travel).
+        if !full && dist0 - travel > reach {
+            return None;
+        }
+        let hit = match c.surface_within(xi, reach) {
+            Some(hit) => hit,
+            None => {
+                if (!full && travel < dist0) || !c.contains_cur(xi) {
+                    return None;
+                }
+                c.surface_any(xi)?
+            }
+        };
+        if hit.signed >= self.to {
+            return None;
+        }
+        // Under the closest surface yet outside the body: a fold of the skin (a posed
+        // crease passing through itself). Pushing out of that surface would push the
+        // vertex into the fold's other side; the winding test is the judge. It costs
+        // three ray casts, so only the full checks ask it (one per step cost 7-15% of
+        // the 1 cm T-shirt's drape time); the exact pass at the end is one of them.
+        if full && hit.signed < 0.0 && !c.contains_cur(xi) {
+            return None;
+        }
+        Some(clear_of_overlaps(c, hit, reach, self.to))
+    }
 }
 
 /// Most projections of one vertex in a step: where two body parts overlap (an arm
@@ -347,17 +428,11 @@ fn project_out(
 /// both, as alternating projections onto two half-spaces reach their intersection.
 const MAX_PROJECTIONS: usize = 4;
 
-/// Vertex `i` moved `to` metres outside the surface of `hit` (the closest to it) and then,
+/// A vertex moved `to` metres outside the surface of `hit` (the closest to it) and then,
 /// while that lands it inside the body (under the surface then closest, within `reach`,
 /// and inside by the winding test), outside that surface too:
-/// `(i, target, outward direction of the last projection)`.
-fn clear_of_overlaps(
-    c: &BodyCollider,
-    i: usize,
-    hit: SurfaceHit,
-    reach: f32,
-    to: f32,
-) -> (usize, Vec3, Vec3) {
+/// `(target, outward direction of the last projection)`.
+fn clear_of_overlaps(c: &BodyCollider, hit: SurfaceHit, reach: f32, to: f32) -> (Vec3, Vec3) {
     let mut target = hit.point + hit.out * to;
     let mut out = hit.out;
     for _ in 1..MAX_PROJECTIONS {
@@ -369,7 +444,7 @@ fn clear_of_overlaps(
             _ => break,
         }
     }
-    (i, target, out)
+    (target, out)
 }
 
 /// Coulomb friction: reduces the tangential part of `vrel` (relative to the surface with unit

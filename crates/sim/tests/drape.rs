@@ -47,7 +47,10 @@ fn a_turned_body_gets_the_same_drape_turned() {
         &mut |_, _, _| {},
     )
     .unwrap();
-    assert!(frames >= (opts.morph_steps + opts.pose_steps) as usize);
+    let s = &turned.stats;
+    assert_eq!(frames, (s.animation_steps + s.settle_steps) as usize);
+    // Without its yaw the pose is the rest pose: the pose phase is a single step.
+    assert!(s.animation_steps <= opts.morph_steps + 1, "{s:?}");
     let expected_body = target.posed(&pose, Skinning::Dqs).unwrap();
     let body_err = turned
         .body
@@ -130,9 +133,16 @@ fn arms_sunk_into_a_heavy_chest_are_cleared_before_draping() {
         &as_given,
         &mut |_, _, _| {},
     );
+    // Without the correction the sleeves end inside the chest: the exact pass at the end
+    // has to walk them out, stretching their edges.
+    let raw = raw.expect("the exact pass leaves no vertex inside").stats;
     assert!(
-        matches!(raw, Err(sim::SimError::Rejected(_))),
-        "without the correction the sleeves end inside: {:?}",
-        raw.map(|d| d.stats)
+        raw.walked_out > 0 && raw.strain_max > 0.5,
+        "without the correction the sleeves end inside: {raw:?}"
+    );
+    let c = &cleared.stats;
+    assert!(
+        c.walked_out == 0 && c.strain_max < raw.strain_max / 2.0,
+        "{c:?}"
     );
 }

@@ -152,7 +152,7 @@ fn projection_clears_a_vertex_caught_where_two_parts_overlap() {
     let mut sim = ClothSim::new(&cloth, &params).unwrap();
     let collider = BodyCollider::new(&body, params.thickness).unwrap();
     assert!(collider.penetration_depths(&[p])[0] > 0.0);
-    assert_eq!(sim.project_out_of(&collider), 1);
+    assert_eq!(sim.project_out_of(&collider), (1, 0));
     let x = sim.positions()[0];
     assert_eq!(collider.penetration_depths(&[x]), vec![0.0], "{x}");
     // Outside both spheres (their faceted meshes lie within 0.02 mm inside them).
@@ -161,6 +161,42 @@ fn projection_clears_a_vertex_caught_where_two_parts_overlap() {
         "{x}"
     );
     assert!(x.distance(p) < 0.01, "moved {} m", x.distance(p));
+    assert_eq!(sim.positions()[1], cloth.vertices[1]);
+}
+
+/// A vertex inside one body part whose closest surface is another part's, seen from
+/// outside (a small sphere within a large one, as a posed shoulder's skin folded into the
+/// torso): projecting onto the closest surface leads nowhere; the exact pass walks it out of
+/// the body the shortest way.
+#[test]
+fn exact_pass_walks_out_a_vertex_whose_closest_surface_leads_nowhere() {
+    let r = 0.2;
+    let (centre_b, r_b) = (Vec3::new(0.1, 0.0, 0.0), 0.06);
+    let mut body = TriMesh::icosphere(5, r);
+    let mut b = TriMesh::icosphere(4, r_b);
+    b.vertices.iter_mut().for_each(|v| *v += centre_b);
+    body.append(&b).unwrap();
+    // 3 cm inside the large sphere, 1 cm outside the small one: the small one's surface is
+    // the closest, and the point is on its outer side.
+    let p = Vec3::new(0.17, 0.0, 0.003);
+    let (depth, gap_b) = (r - p.length(), p.distance(centre_b) - r_b);
+    assert!(gap_b > 0.0 && gap_b < depth, "{depth} {gap_b}");
+    let params = ClothParams::default();
+    let cloth = TriMesh {
+        vertices: vec![p, Vec3::new(0.3, 0.0, 0.0), Vec3::new(0.3, 0.05, 0.0)],
+        faces: vec![[0, 1, 2]],
+    };
+    let mut sim = ClothSim::new(&cloth, &params).unwrap();
+    let collider = BodyCollider::new(&body, params.thickness).unwrap();
+    // Inside; its depth is measured to the closest surface, the small sphere's.
+    assert!(collider.penetration_depths(&[p])[0] > 0.009);
+    assert_eq!(sim.project_out_of(&collider), (1, 1));
+    let x = sim.positions()[0];
+    assert_eq!(collider.penetration_depths(&[x]), vec![0.0], "{x}");
+    assert!(x.length() > r, "{x}");
+    // The shortest way out is about 3 cm (straight out along +x); no direction tried is
+    // more than a few degrees off it.
+    assert!(x.distance(p) < depth + 0.01, "moved {} m", x.distance(p));
     assert_eq!(sim.positions()[1], cloth.vertices[1]);
 }
 

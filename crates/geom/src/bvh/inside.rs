@@ -42,14 +42,13 @@ pub(super) fn ray_box(n: &Node, o: Vec3, d: Vec3, inv: Vec3, t_max: f32) -> bool
 }
 
 impl Bvh {
-    /// Winding number of `p` counted along the ray from `p` in direction `dir`:
-    /// exits minus entries (a crossing is an exit when the face normal points along the ray).
-    pub fn ray_winding(&self, p: Vec3, dir: Vec3) -> i32 {
+    /// Calls `f(t, s)` for every face the ray `p + t dir`, `t > 0`, crosses: `s` is +1 for an
+    /// exit (the face normal points along the ray), -1 for an entry.
+    fn for_each_crossing(&self, p: Vec3, dir: Vec3, mut f: impl FnMut(f32, i32)) {
         if self.nodes.is_empty() {
-            return 0;
+            return;
         }
         let inv = dir.recip();
-        let mut w = 0;
         let mut stack: Vec<u32> = Vec::with_capacity(64);
         stack.push(0);
         while let Some(ni) = stack.pop() {
@@ -63,7 +62,7 @@ impl Bvh {
                     if let Some((t, _)) = ray_triangle(p, dir, f32::INFINITY, a, b, c) {
                         if t > 0.0 {
                             let s = (b - a).cross(c - a).dot(dir);
-                            w += if s > 0.0 { 1 } else { -1 };
+                            f(t, if s > 0.0 { 1 } else { -1 });
                         }
                     }
                 }
@@ -72,7 +71,42 @@ impl Bvh {
                 stack.push(n.start + 1);
             }
         }
+    }
+
+    /// Winding number of `p` counted along the ray from `p` in direction `dir`:
+    /// exits minus entries (a crossing is an exit when the face normal points along the ray).
+    pub fn ray_winding(&self, p: Vec3, dir: Vec3) -> i32 {
+        let mut w = 0;
+        self.for_each_crossing(p, dir, |_, s| w += s);
         w
+    }
+
+    /// How far along the ray from `p` in direction `dir` (unit) the first point outside the
+    /// mesh lies, counting the winding number along this ray alone (see
+    /// [`Bvh::ray_winding`]): 0 when `p` is outside by this ray; the distance of the crossing
+    /// after which no part of the mesh encloses the ray any more otherwise (where a posed
+    /// body overlaps itself, the exit out of both parts, not the first surface met). `None`
+    /// for an empty mesh, a non-finite `p` or a count that never drops to 0 (a ray
+    /// grazing an edge). Metres if `dir` is a unit vector.
+    pub fn ray_exit(&self, p: Vec3, dir: Vec3) -> Option<f32> {
+        if self.nodes.is_empty() || !p.is_finite() {
+            return None;
+        }
+        // (distance, +1 exit / -1 entry) of every crossing beyond p.
+        let mut hits: Vec<(f32, i32)> = Vec::new();
+        self.for_each_crossing(p, dir, |t, s| hits.push((t, s)));
+        let mut w: i32 = hits.iter().map(|h| h.1).sum();
+        if w <= 0 {
+            return Some(0.0);
+        }
+        hits.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for (t, s) in hits {
+            w -= s;
+            if w <= 0 {
+                return Some(t);
+            }
+        }
+        None
     }
 
     /// Whether `p` is inside the mesh (winding number at least 1 along a majority of three
@@ -181,5 +215,39 @@ mod tests {
         let cube = Bvh::from_mesh(&TriMesh::cuboid(Vec3::ONE)).unwrap();
         assert!(cube.contains(Vec3::ZERO) && !cube.contains(Vec3::splat(1.5)));
         assert!(cube.contains(Vec3::new(0.999, 0.0, 0.0)));
+    }
+
+    #[test]
+    fn ray_exit_leaves_every_overlapping_shell() {
+        // Two unit spheres centred at x = 0 and x = 0.5 (icospheres: radius within 1% of 1).
+        let mut m = TriMesh::icosphere(3, 1.0);
+        let mut other = TriMesh::icosphere(3, 1.0);
+        for v in &mut other.vertices {
+            v.x += 0.5;
+        }
+        m.append(&other).unwrap();
+        let bvh = Bvh::from_mesh(&m).unwrap();
+        let p = Vec3::new(0.25, 0.0, 0.0); // inside both
+        let d = DIRS[0];
+        // Along +x the first surface met is the first sphere's at x = 1, still inside the
+        // second; the exit is the second sphere's surface at x = 1.5.
+        let t = bvh.ray_exit(p, Vec3::X.lerp(d, 1e-3).normalize()).unwrap();
+        assert!((t - 1.25).abs() < 0.02, "{t}");
+        let t = bvh.ray_exit(p, -Vec3::X.lerp(d, 1e-3).normalize()).unwrap();
+        assert!((t - 1.25).abs() < 0.02, "{t}");
+        // Outside: 0. Just past every exit found, the point is outside.
+        assert_eq!(bvh.ray_exit(Vec3::new(3.0, 0.0, 0.0), d), Some(0.0));
+        let mut rng = Rng(9);
+        for _ in 0..200 {
+            let q = rng.vec3(1.2);
+            let dir = rng.vec3(1.0).normalize();
+            let Some(t) = bvh.ray_exit(q, dir) else {
+                continue;
+            };
+            assert_eq!(t == 0.0, !bvh.contains(q), "{q}");
+            assert!(!bvh.contains(q + dir * (t + 1e-3)), "{q} {dir} {t}");
+        }
+        assert_eq!(Bvh::default().ray_exit(p, d), None);
+        assert_eq!(bvh.ray_exit(Vec3::NAN, d), None);
     }
 }
