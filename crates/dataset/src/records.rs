@@ -34,6 +34,10 @@ pub struct SimStats {
     /// The largest turn of a limb joint by the pose's clearance correction, degrees.
     #[serde(default)]
     pub limb_turn_deg: f32,
+    /// Garment vertices walked out of the body the shortest way after the last step
+    /// (caught between overlapping body parts; see `sim::stats::DrapeStats::walked_out`).
+    #[serde(default)]
+    pub walked_out: u32,
 }
 
 impl From<&DrapeStats> for SimStats {
@@ -50,6 +54,7 @@ impl From<&DrapeStats> for SimStats {
             strain_max: s.strain_max,
             converged: s.converged,
             limb_turn_deg: s.limb_turn_deg,
+            walked_out: s.walked_out,
         }
     }
 }

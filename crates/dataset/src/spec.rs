@@ -229,7 +229,9 @@ pub struct SimulatorSpec {
     /// Steps of the move into the pose.
     pub pose_steps: Option<u32>,
     /// Most distance a body vertex travels in one animation step, metres (0: always the
-    /// full step counts).
+    /// full step counts). Left out of the canonical JSON when absent, so the hash of every
+    /// spec written before it existed stays the same (its datasets still resume).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub body_step: Option<f32>,
     /// Most settling steps.
     pub max_settle_steps: Option<u32>,
