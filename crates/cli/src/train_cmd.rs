@@ -57,6 +57,14 @@ pub struct TrainArgs {
     /// Train on at most this many training samples (quick runs).
     #[arg(long, value_name = "N")]
     pub max_samples: Option<usize>,
+    /// Train only on drapes whose strain p99 (simulator statistics) is at most this, percent:
+    /// a garment stretched far beyond what cloth does (caught on a body part in an extreme
+    /// pose) is a poor label. Validation and evaluation keep every sample.
+    #[arg(long, value_name = "PCT")]
+    pub max_strain: Option<f32>,
+    /// Train only on drapes that came to rest within the simulator's step budget.
+    #[arg(long)]
+    pub at_rest: bool,
     /// Loss weights: turn a term off for ablations (L_vertex stays).
     #[arg(long)]
     pub no_pen: bool,
@@ -139,6 +147,40 @@ impl<'a> GarmentSplit<'a> {
         })
     }
 
+    /// Keeps only the samples whose drape came to rest (with `at_rest`) and whose strain
+    /// p99 is at most `max_strain_p99` (a fraction, when given). Returns how many were
+    /// dropped; errors when none is left.
+    pub fn keep_good_drapes(
+        &mut self,
+        max_strain_p99: Option<f32>,
+        at_rest: bool,
+    ) -> anyhow::Result<usize> {
+        let good: std::collections::HashSet<u64> = self
+            .data
+            .manifest()
+            .samples
+            .iter()
+            .filter(|e| {
+                let st = &e.record.stats;
+                (!at_rest || st.converged) && max_strain_p99.is_none_or(|m| st.strain_p99 <= m)
+            })
+            .map(|e| e.record.index)
+            .collect();
+        let before = self.indices.len();
+        self.indices.retain(|i| good.contains(i));
+        if self.indices.is_empty() {
+            bail!(
+                "{}: none of the {before} samples is a drape at rest{} (--at-rest, --max-strain)",
+                self.data.dir().display(),
+                max_strain_p99.map_or(String::new(), |m| format!(
+                    " with strain p99 at most {}%",
+                    m * 100.0
+                ))
+            );
+        }
+        Ok(before - self.indices.len())
+    }
+
     /// The garment template the samples share (metres).
     pub fn template(&self) -> anyhow::Result<std::sync::Arc<garment::GarmentTemplate>> {
         let first = self.data.sample(self.indices[0])?;
@@ -182,6 +224,13 @@ impl<'a> GarmentSplit<'a> {
 pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
     let data = Dataset::open(&args.data)?;
     let mut train = GarmentSplit::new(&data, "train", &args.garment)?;
+    if args.max_strain.is_some() || args.at_rest {
+        if let Some(m) = args.max_strain.filter(|m| !(m.is_finite() && *m >= 0.0)) {
+            bail!("--max-strain must be a non-negative percentage, got {m}");
+        }
+        let dropped = train.keep_good_drapes(args.max_strain.map(|m| m / 100.0), args.at_rest)?;
+        eprintln!("left out {dropped} training drapes not at rest or strained beyond the limit");
+    }
     if let Some(n) = args.max_samples {
         train.indices.truncate(n.max(1));
     }

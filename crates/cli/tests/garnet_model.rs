@@ -234,6 +234,42 @@ fn train_resume_eval_and_drape() {
 }
 
 #[test]
+fn train_leaves_out_drapes_not_at_rest_or_overstretched() {
+    let data = dataset();
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("filtered");
+    let train = |extra: &[&str]| {
+        let mut a = vec![
+            "train",
+            "--data",
+            s(data),
+            "--garment",
+            "tshirt",
+            "--variant",
+            "naive",
+            "--epochs",
+            "1",
+            "--out",
+            s(&out),
+        ];
+        a.extend_from_slice(extra);
+        a.into_iter().map(String::from).collect::<Vec<_>>()
+    };
+    let log = ok(&as_str(&train(&["--max-strain", "1000"])));
+    assert!(log.contains("left out 0 training drapes"), "{log}");
+    // Five settling steps: no drape of this dataset is at rest, and every one is strained.
+    let err = fails(&as_str(&train(&["--at-rest"])));
+    assert!(
+        err.contains("none of the 2 samples") && err.contains("--at-rest"),
+        "{err}"
+    );
+    let err = fails(&as_str(&train(&["--max-strain", "0"])));
+    assert!(err.contains("strain p99 at most 0%"), "{err}");
+    let err = fails(&as_str(&train(&["--max-strain=-1"])));
+    assert!(err.contains("--max-strain"), "{err}");
+}
+
+#[test]
 fn drape_and_eval_refuse_what_does_not_fit() {
     let data = dataset();
     let tmp = tempfile::tempdir().unwrap();
