@@ -63,24 +63,13 @@ fn train_resume_eval_and_drape() {
     let tmp = tempfile::tempdir().unwrap();
     let local = tmp.path().join("local");
     let args = |epochs: &str| {
-        vec![
-            "train",
-            "--data",
-            s(data),
-            "--garment",
-            "tshirt",
-            "--variant",
+        owned(&train_args(
+            data,
             "local",
-            "--epochs",
             epochs,
-            "--batch",
-            "2",
-            "--out",
-            s(&local),
-        ]
-        .into_iter()
-        .map(String::from)
-        .collect::<Vec<_>>()
+            &local,
+            &["--batch", "2"],
+        ))
     };
     let log = ok(&as_str(&args("2")));
     assert!(
@@ -102,23 +91,13 @@ fn train_resume_eval_and_drape() {
 
     // Naive with clipped gradients and a cosine schedule over two epochs.
     let naive = tmp.path().join("naive");
-    let log = ok(&[
-        "train",
-        "--data",
-        s(data),
-        "--garment",
-        "tshirt",
-        "--variant",
+    let log = ok(&train_args(
+        data,
         "naive",
-        "--epochs",
         "2",
-        "--grad-clip",
-        "100",
-        "--cosine-to",
-        "1e-4",
-        "--out",
-        s(&naive),
-    ]);
+        &naive,
+        &["--grad-clip", "100", "--cosine-to", "1e-4"],
+    ));
     assert!(
         log.contains("cosine to 0.0001 at epoch 2, from epoch 0")
             && log.contains("gradients clipped to norm 100")
@@ -238,23 +217,7 @@ fn train_leaves_out_drapes_not_at_rest_or_overstretched() {
     let data = dataset();
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("filtered");
-    let train = |extra: &[&str]| {
-        let mut a = vec![
-            "train",
-            "--data",
-            s(data),
-            "--garment",
-            "tshirt",
-            "--variant",
-            "naive",
-            "--epochs",
-            "1",
-            "--out",
-            s(&out),
-        ];
-        a.extend_from_slice(extra);
-        a.into_iter().map(String::from).collect::<Vec<_>>()
-    };
+    let train = |extra: &[&str]| owned(&train_args(data, "naive", "1", &out, extra));
     let log = ok(&as_str(&train(&["--max-strain", "1000"])));
     assert!(log.contains("left out 0 training drapes"), "{log}");
     // Five settling steps: no drape of this dataset is at rest, and every one is strained.
@@ -305,6 +268,35 @@ fn drape_and_eval_refuse_what_does_not_fit() {
 }
 
 /// `v` as the `&str` arguments [`ok`] takes.
+/// `garnet train` on `data`'s T-shirts with `variant` for `epochs` into `out`, then `extra`.
+fn train_args<'a>(
+    data: &'a Path,
+    variant: &'a str,
+    epochs: &'a str,
+    out: &'a Path,
+    extra: &[&'a str],
+) -> Vec<&'a str> {
+    let mut a = vec![
+        "train",
+        "--data",
+        s(data),
+        "--garment",
+        "tshirt",
+        "--variant",
+        variant,
+        "--epochs",
+        epochs,
+        "--out",
+        s(out),
+    ];
+    a.extend_from_slice(extra);
+    a
+}
+
+fn owned(v: &[&str]) -> Vec<String> {
+    v.iter().map(|a| a.to_string()).collect()
+}
+
 fn as_str(v: &[String]) -> Vec<&str> {
     v.iter().map(String::as_str).collect()
 }
