@@ -34,8 +34,8 @@ pub struct SimStats {
     /// The largest turn of a limb joint by the pose's clearance correction, degrees.
     #[serde(default)]
     pub limb_turn_deg: f32,
-    /// Garment vertices walked out of the body the shortest way after the last step
-    /// (caught between overlapping body parts; see `sim::stats::DrapeStats::walked_out`).
+    /// Walks of garment vertices out of the body the shortest way (caught between
+    /// overlapping body parts; see `sim::stats::DrapeStats::walked_out`).
     #[serde(default)]
     pub walked_out: u32,
 }

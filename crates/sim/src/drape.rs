@@ -36,6 +36,12 @@ pub struct DrapeOptions {
     pub body_step: f32,
     /// Most steps spent settling after the animation.
     pub max_settle_steps: u32,
+    /// While settling, every this many steps (from the first), cloth caught inside the
+    /// body where its closest surface leads no way out (between overlapping body parts) is
+    /// walked out ([`ClothSim::walk_out_of`]), so the cloth relaxes around it instead of
+    /// jittering against the per-step projection; 0: only by the exact pass after the
+    /// last step.
+    pub walk_out_every: u32,
     /// The cloth is at rest when its root-mean-square speed falls below this, m/s.
     pub rest_speed: f32,
     /// A drape whose cloth moves faster than this (root-mean-square, m/s) has diverged.
@@ -63,6 +69,7 @@ impl Default for DrapeOptions {
             pose_steps: 60,
             body_step: 0.008,
             max_settle_steps: 400,
+            walk_out_every: 50,
             rest_speed: 0.005,
             explode_speed: 30.0,
             max_penetration: 0.001,
@@ -203,16 +210,21 @@ pub fn drape(
     }
     let animation_steps = step;
     let mut converged = false;
+    let mut walked = 0;
     while step - animation_steps < opts.max_settle_steps {
+        let settled = step - animation_steps;
+        if opts.walk_out_every > 0 && settled % opts.walk_out_every == 0 {
+            walked += sim.walk_out_of(&collider);
+        }
         advance(&mut sim, &mut collider, &body, &mut step)?;
         if rms_speed(&sim) < opts.rest_speed {
             converged = true;
             break;
         }
     }
-    let (_, walked_out) = sim.project_out_of(&collider);
+    walked += sim.project_out_of(&collider).1;
     let mut stats = DrapeStats {
-        walked_out: walked_out as u32,
+        walked_out: walked as u32,
         animation_steps,
         settle_steps: step - animation_steps,
         final_kinetic_energy: sim.kinetic_energy(),

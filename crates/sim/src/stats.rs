@@ -31,10 +31,11 @@ pub struct DrapeStats {
     /// The largest turn of a limb joint by the clearance correction of the pose, degrees.
     #[serde(default)]
     pub limb_turn_deg: f32,
-    /// Garment vertices that the exact pass after the last step found inside the body with
-    /// no way out through their closest surface (caught between overlapping body parts or
-    /// under a fold of skin) and walked out the shortest way
-    /// ([`crate::ClothSim::project_out_of`]); each leaves a spike in the cloth.
+    /// Walks of garment vertices out of the body the shortest way: vertices found inside
+    /// with no way out through their closest surface (caught between overlapping body
+    /// parts or under a fold of skin), by the walks while settling
+    /// ([`crate::ClothSim::walk_out_of`]) and the exact pass after the last step (a vertex
+    /// caught again counts again). Each can leave a spike in the cloth.
     #[serde(default)]
     pub walked_out: u32,
 }
@@ -79,7 +80,7 @@ impl DrapeStats {
             self.limb_turn_deg
         ) + &match self.walked_out {
             0 => String::new(),
-            n => format!(", {n} vertices walked out of the body"),
+            n => format!(", {n} walks out of the body"),
         }
     }
 }

@@ -236,10 +236,23 @@ impl ClothSim {
     /// a simulation, so that no vertex is left inside. Returns how many vertices moved and
     /// how many of them went the shortest way out.
     pub fn project_out_of(&mut self, collider: &BodyCollider) -> (usize, usize) {
+        self.exact_pass(collider, false)
+    }
+
+    /// Of the moves [`ClothSim::project_out_of`] would make, only the walks out of the body
+    /// (vertices inside with no way out through their closest surface): during a
+    /// simulation, so that cloth caught between body parts gets free without disturbing
+    /// the cloth resting in contact. Returns how many vertices moved.
+    pub fn walk_out_of(&mut self, collider: &BodyCollider) -> usize {
+        self.exact_pass(collider, true).1
+    }
+
+    /// [`ClothSim::project_out_of`], applying only the walks out with `walks_only`.
+    fn exact_pass(&mut self, collider: &BodyCollider, walks_only: bool) -> (usize, usize) {
         let (thick, reach) = self.thickness_and_reach(Some(collider));
         let dist0 = vec![0.0; self.x.len()];
         let x = self.x.clone();
-        let fixes = project_out(
+        let mut fixes = project_out(
             self,
             collider,
             &x,
@@ -248,6 +261,9 @@ impl ClothSim {
             thick * PROJECT_FRACTION,
             Check::Exact,
         );
+        if walks_only {
+            fixes.retain(|f| f.walked_out);
+        }
         for f in &fixes {
             self.x[f.i] = f.target;
             self.v[f.i] = Vec3::ZERO;

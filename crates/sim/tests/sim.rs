@@ -152,6 +152,9 @@ fn projection_clears_a_vertex_caught_where_two_parts_overlap() {
     let mut sim = ClothSim::new(&cloth, &params).unwrap();
     let collider = BodyCollider::new(&body, params.thickness).unwrap();
     assert!(collider.penetration_depths(&[p])[0] > 0.0);
+    // Projection leads out: nothing to walk out.
+    assert_eq!(sim.walk_out_of(&collider), 0);
+    assert_eq!(sim.positions(), &cloth.vertices[..]);
     assert_eq!(sim.project_out_of(&collider), (1, 0));
     let x = sim.positions()[0];
     assert_eq!(collider.penetration_depths(&[x]), vec![0.0], "{x}");
@@ -190,7 +193,10 @@ fn exact_pass_walks_out_a_vertex_whose_closest_surface_leads_nowhere() {
     let collider = BodyCollider::new(&body, params.thickness).unwrap();
     // Inside; its depth is measured to the closest surface, the small sphere's.
     assert!(collider.penetration_depths(&[p])[0] > 0.009);
+    let mut walker = ClothSim::new(&cloth, &params).unwrap();
+    assert_eq!(walker.walk_out_of(&collider), 1);
     assert_eq!(sim.project_out_of(&collider), (1, 1));
+    assert_eq!(walker.positions(), sim.positions());
     let x = sim.positions()[0];
     assert_eq!(collider.penetration_depths(&[x]), vec![0.0], "{x}");
     assert!(x.length() > r, "{x}");
