@@ -116,7 +116,15 @@ impl Bvh {
         if !p.is_finite() {
             return false;
         }
-        DIRS.iter().filter(|&&d| self.ray_winding(p, d) > 0).count() >= 2
+        // A majority of three: when the first two rays agree, the third cannot change it
+        // (saves a third of the ray casts: the rays almost always agree).
+        let inside = |d: Vec3| self.ray_winding(p, d) > 0;
+        let (a, b) = (inside(DIRS[0]), inside(DIRS[1]));
+        if a == b {
+            a
+        } else {
+            inside(DIRS[2])
+        }
     }
 
     /// Signed distance from `p` to the mesh (metres): negative inside (see [`Bvh::contains`]),
@@ -215,6 +223,23 @@ mod tests {
         let cube = Bvh::from_mesh(&TriMesh::cuboid(Vec3::ONE)).unwrap();
         assert!(cube.contains(Vec3::ZERO) && !cube.contains(Vec3::splat(1.5)));
         assert!(cube.contains(Vec3::new(0.999, 0.0, 0.0)));
+    }
+
+    #[test]
+    fn contains_is_the_majority_of_the_three_rays() {
+        let mut m = TriMesh::icosphere(2, 1.0);
+        let mut other = TriMesh::icosphere(2, 1.0);
+        for v in &mut other.vertices {
+            v.x += 0.5;
+        }
+        m.append(&other).unwrap();
+        let bvh = Bvh::from_mesh(&m).unwrap();
+        let mut rng = Rng(31);
+        for _ in 0..2000 {
+            let p = rng.vec3(1.6);
+            let votes = DIRS.iter().filter(|&&d| bvh.ray_winding(p, d) > 0).count();
+            assert_eq!(bvh.contains(p), votes >= 2, "{p}");
+        }
     }
 
     #[test]
