@@ -2,10 +2,10 @@
 //!
 //! A TOML [`spec`] names the garments, the body-shape distribution, the pose sources,
 //! the counts, the seed, the splits and the simulator settings. The [`plan`] enumerates
-//! every sample from the seed alone; [`generate`] drapes them in parallel into
+//! every sample from the seed alone; [`generate`](mod@generate) drapes them in parallel into
 //! safetensors [`shard`]s (a fixed range of sample indices each, byte-identical whatever
 //! the number of jobs, the interruptions or the `--shard i/n` split of the work) with a
-//! JSON [`manifest`]; generation resumes where it stopped; [`merge`] joins the folders
+//! JSON [`manifest`]; generation resumes where it stopped; [`merge`](mod@merge) joins the folders
 //! of a job array. [`reader::Dataset`] reads samples back with checksums verified, and
 //! [`batches`] streams shuffled batches of a split without loading the dataset.
 //!

@@ -2,7 +2,7 @@
 //!
 //! Every random choice of a dataset (a body's shape seed, its cut, its poses, the split
 //! permutation, the frames drawn from a clip) comes from a [`SplitMix64`] stream seeded by
-//! [`derive`] from the spec's seed and the choice's coordinates, so any sample can be
+//! [`derive()`] from the spec's seed and the choice's coordinates, so any sample can be
 //! produced alone, in any order, on any machine. SplitMix64 is written out here (not taken
 //! from `rand`) so datasets stay reproducible across dependency upgrades.
 

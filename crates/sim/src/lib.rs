@@ -11,7 +11,7 @@
 //! pattern), Chebyshev-accelerated. Contacts with the body are constraints inside that
 //! solve (a push out of the body's tangent plane plus Coulomb friction toward a
 //! body-carried anchor); a projection after the solve keeps every vertex out of the body
-//! ([`step`]). [`reference`] holds plain versions of the optimised kernels for tests;
+//! ([`step`]). [`reference`](mod@reference) holds plain versions of the optimised kernels for tests;
 //! [`shapes`] builds procedural test scenes (capsule body, tube shirt).
 //!
 //! Units: metres, seconds, kilograms; Y up; gravity -Y.

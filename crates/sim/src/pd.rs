@@ -8,7 +8,7 @@
 //! ```
 //!
 //! alternating a local step (`p_c`: the current vector `x_a - x_b` scaled to the rest length;
-//! `q_i`: the contact target, see [`Contact::target`]) and a global step, a solve with the
+//! `q_i`: the contact target, see `Contact::target`) and a global step, a solve with the
 //! constant matrix `M/h^2 + sum w_c S_c^T S_c + diag(k)` factorised once. Bending pairs enter
 //! that matrix by their diagonal only and their off-diagonal part is taken from the current
 //! iterate (a Jacobi splitting): bending weights are about a thousandth of the stretch

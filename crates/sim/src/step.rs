@@ -2,7 +2,7 @@
 //!
 //! A step of length `h`:
 //! 1. **Contacts.** Every free vertex within thickness + margin of the body at the start of
-//!    the step (closest point through the BVH) gets a [`Contact`]: the body's tangent plane
+//!    the step (closest point through the BVH) gets a `Contact`: the body's tangent plane
 //!    at the end of the step, and an anchor, its start position carried by the motion of its
 //!    body point (a barycentric attachment), so a fast body carries the cloth it touches
 //!    instead of leaving it behind or passing through it.
@@ -229,10 +229,11 @@ impl ClothSim {
 
     /// Moves every free vertex inside the body, or closer to it than half the thickness, out
     /// of it as the projection after each step does, but with the exact inside test for every
-    /// vertex (the steps run it every [`FULL_INSIDE_CHECK`] steps) and without a time step:
+    /// vertex (the steps run it every 20 steps) and without a time step:
     /// the moved vertices stop. A vertex still inside after that (caught where two body
     /// parts overlap, or under a fold of skin, where the closest surface leads no way out)
-    /// goes the shortest way out of the body ([`BodyCollider::exit_point`]). For the end of
+    /// goes the shortest way out of the body: along 32 directions, the nearest point where no
+    /// body part encloses the ray any more ([`geom::Bvh::ray_exit`]). For the end of
     /// a simulation, so that no vertex is left inside. Returns how many vertices moved and
     /// how many of them went the shortest way out.
     pub fn project_out_of(&mut self, collider: &BodyCollider) -> (usize, usize) {
