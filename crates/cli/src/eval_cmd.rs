@@ -7,11 +7,11 @@ use std::collections::{BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{anyhow, Context};
+use anyhow::{anyhow, bail, Context};
 use body::{BodyModel, Phenotype, Pose, Skinning};
 use clap::Args;
 use dataset::batches::{BatchOptions, Batches, Order};
-use dataset::Dataset;
+use dataset::{Dataset, DrapeFilter};
 use geom::metrics::{face_normal_angles, precision_curve, vertex_distances};
 use geom::{Bvh, TriMesh};
 use glam::Vec3;
@@ -20,6 +20,7 @@ use render::plot::{Chart, Series};
 use serde::Serialize;
 
 use crate::drape_cmd::checkpoint_template;
+use crate::drape_filter_args::DrapeFilterArgs;
 use crate::model_device::DeviceArg;
 use crate::simulate_cmd::write_json;
 
@@ -41,6 +42,9 @@ pub struct EvalArgs {
     /// Evaluate at most this many samples per garment.
     #[arg(long, value_name = "N")]
     pub max_samples: Option<usize>,
+    /// Which drapes to evaluate on (default: every one; the report says which).
+    #[command(flatten)]
+    pub drapes: DrapeFilterArgs,
     /// Where the networks run.
     #[arg(long, value_enum, default_value_t = DeviceArg::Cpu)]
     pub device: DeviceArg,
@@ -219,12 +223,13 @@ impl EvalData {
         &self.data
     }
 
-    /// Evaluates the model at `path` on `split` (at most `max_samples` samples of its
-    /// garment).
+    /// Evaluates the model at `path` on `split` (the drapes `filter` keeps, when given; at
+    /// most `max_samples` samples of its garment).
     pub fn evaluate(
         &self,
         path: &Path,
         split: &str,
+        filter: Option<&DrapeFilter>,
         max_samples: Option<usize>,
         device: &burn::prelude::Device,
     ) -> anyhow::Result<ModelEvaluation> {
@@ -235,6 +240,16 @@ impl EvalData {
         let faces = &template.mesh.faces;
         let garment = matching_garment(data, split, &template.mesh)?;
         let mut indices = data.select(Some(split), Some(&garment))?;
+        if let Some(f) = filter {
+            data.retain_drapes(&mut indices, f);
+            if indices.is_empty() {
+                bail!(
+                    "{}: no '{garment}' sample of split '{split}' is one of the {}",
+                    data.dir().display(),
+                    f.describe()
+                );
+            }
+        }
         if let Some(n) = max_samples {
             indices.truncate(n);
         }
@@ -290,27 +305,44 @@ impl EvalData {
 /// Runs `garnet eval`.
 pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
     let device = args.device.device()?;
+    let filter = args.drapes.filter()?;
     let data = EvalData::open(&args.data)?;
     let mut rows: Vec<Row> = Vec::new();
     let mut timings: Vec<Timing> = Vec::new();
     let mut dqs_done: BTreeSet<String> = BTreeSet::new();
     for path in &args.models {
-        let e = data.evaluate(path, &args.split, args.max_samples, &device)?;
+        let e = data.evaluate(
+            path,
+            &args.split,
+            filter.as_ref(),
+            args.max_samples,
+            &device,
+        )?;
         rows.push(e.net);
         if dqs_done.insert(e.garment) {
             rows.push(e.dqs);
         }
         timings.push(e.timing);
     }
-    write_reports(&args.out, &args.split, &rows, &timings)
+    let only = filter.map(|f| f.describe());
+    write_reports(&args.out, &args.split, only.as_deref(), &rows, &timings)
 }
 
 /// Writes results.md, results.json and the two precision-curve PNGs into `out`.
-fn write_reports(out: &Path, split: &str, rows: &[Row], timings: &[Timing]) -> anyhow::Result<()> {
+/// `only`: which drapes were evaluated, when not all.
+fn write_reports(
+    out: &Path,
+    split: &str,
+    only: Option<&str>,
+    rows: &[Row],
+    timings: &[Timing],
+) -> anyhow::Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let mut md = format!(
-        "# GarNet evaluation (split '{split}')\n\n## Table 1: errors\n\n| garment | method | samples | E_dist (cm) | E_norm (deg) | vertices inside body |\n|---|---|---:|---:|---:|---:|\n"
-    );
+    let mut md = format!("# GarNet evaluation (split '{split}')\n\n");
+    if let Some(only) = only {
+        md += &format!("Only {only} (`--at-rest`, `--max-strain`).\n\n");
+    }
+    md += "## Table 1: errors\n\n| garment | method | samples | E_dist (cm) | E_norm (deg) | vertices inside body |\n|---|---|---:|---:|---:|---:|\n";
     for r in rows {
         md += &format!(
             "| {} | {} | {} | {:.3} | {:.2} | {:.2}% |\n",

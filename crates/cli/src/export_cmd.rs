@@ -48,7 +48,7 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
     }
     save_checkpoint(&args.out, &network, None, &ck.setup, &ck.loss, &ck.state)?;
     let data = EvalData::open(&args.data)?;
-    let eval = data.evaluate(&args.out, &args.split, args.max_samples, &device)?;
+    let eval = data.evaluate(&args.out, &args.split, None, args.max_samples, &device)?;
     let card = model_card(
         &args.model,
         &args.out,

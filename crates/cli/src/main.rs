@@ -7,6 +7,7 @@ mod body_cmd;
 mod dataset_cmd;
 mod dataset_show;
 mod drape_cmd;
+mod drape_filter_args;
 mod eval_cmd;
 mod export_cmd;
 mod garment_cmd;

@@ -8,13 +8,14 @@ use anyhow::{bail, Context};
 use burn::module::Module;
 use clap::{Args, ValueEnum};
 use dataset::batches::{BatchOptions, Batches, Order};
-use dataset::Dataset;
+use dataset::{Dataset, DrapeFilter};
 use indicatif::{ProgressBar, ProgressStyle};
 use model::{
     BodyTopology, CosineSchedule, GarNetConfig, LossConfig, ModelSetup, Sample, Trainer, Variant,
     PAPER_LEARNING_RATE,
 };
 
+use crate::drape_filter_args::DrapeFilterArgs;
 use crate::model_device::DeviceArg;
 
 /// Arguments of `garnet train`.
@@ -57,14 +58,9 @@ pub struct TrainArgs {
     /// Train on at most this many training samples (quick runs).
     #[arg(long, value_name = "N")]
     pub max_samples: Option<usize>,
-    /// Train only on drapes whose strain p99 (simulator statistics) is at most this, percent:
-    /// a garment stretched far beyond what cloth does (caught on a body part in an extreme
-    /// pose) is a poor label. Validation and evaluation keep every sample.
-    #[arg(long, value_name = "PCT")]
-    pub max_strain: Option<f32>,
-    /// Train only on drapes that came to rest within the simulator's step budget.
-    #[arg(long)]
-    pub at_rest: bool,
+    /// Which training drapes to use (validation keeps every sample).
+    #[command(flatten)]
+    pub drapes: DrapeFilterArgs,
     /// Loss weights: turn a term off for ablations (L_vertex stays).
     #[arg(long)]
     pub no_pen: bool,
@@ -147,38 +143,19 @@ impl<'a> GarmentSplit<'a> {
         })
     }
 
-    /// Keeps only the samples whose drape came to rest (with `at_rest`) and whose strain
-    /// p99 is at most `max_strain_p99` (a fraction, when given). Returns how many were
-    /// dropped; errors when none is left.
-    pub fn keep_good_drapes(
-        &mut self,
-        max_strain_p99: Option<f32>,
-        at_rest: bool,
-    ) -> anyhow::Result<usize> {
-        let good: std::collections::HashSet<u64> = self
-            .data
-            .manifest()
-            .samples
-            .iter()
-            .filter(|e| {
-                let st = &e.record.stats;
-                (!at_rest || st.converged) && max_strain_p99.is_none_or(|m| st.strain_p99 <= m)
-            })
-            .map(|e| e.record.index)
-            .collect();
+    /// Keeps only the samples whose drape passes `filter`. Returns how many were dropped;
+    /// errors when none is left.
+    pub fn keep_drapes(&mut self, filter: &DrapeFilter) -> anyhow::Result<usize> {
         let before = self.indices.len();
-        self.indices.retain(|i| good.contains(i));
+        let dropped = self.data.retain_drapes(&mut self.indices, filter);
         if self.indices.is_empty() {
             bail!(
-                "{}: none of the {before} samples is a drape at rest{} (--at-rest, --max-strain)",
+                "{}: none of the {before} samples is one of the {} (--at-rest, --max-strain)",
                 self.data.dir().display(),
-                max_strain_p99.map_or(String::new(), |m| format!(
-                    " with strain p99 at most {}%",
-                    m * 100.0
-                ))
+                filter.describe()
             );
         }
-        Ok(before - self.indices.len())
+        Ok(dropped)
     }
 
     /// The garment template the samples share (metres).
@@ -224,12 +201,12 @@ impl<'a> GarmentSplit<'a> {
 pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
     let data = Dataset::open(&args.data)?;
     let mut train = GarmentSplit::new(&data, "train", &args.garment)?;
-    if args.max_strain.is_some() || args.at_rest {
-        if let Some(m) = args.max_strain.filter(|m| !(m.is_finite() && *m >= 0.0)) {
-            bail!("--max-strain must be a non-negative percentage, got {m}");
-        }
-        let dropped = train.keep_good_drapes(args.max_strain.map(|m| m / 100.0), args.at_rest)?;
-        eprintln!("left out {dropped} training drapes not at rest or strained beyond the limit");
+    if let Some(filter) = args.drapes.filter()? {
+        let dropped = train.keep_drapes(&filter)?;
+        eprintln!(
+            "training on {} only: left out {dropped} training drapes",
+            filter.describe()
+        );
     }
     if let Some(n) = args.max_samples {
         train.indices.truncate(n.max(1));

@@ -213,13 +213,35 @@ fn train_resume_eval_and_drape() {
 }
 
 #[test]
-fn train_leaves_out_drapes_not_at_rest_or_overstretched() {
+fn train_and_eval_leave_out_drapes_not_at_rest_or_overstretched() {
     let data = dataset();
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("filtered");
     let train = |extra: &[&str]| owned(&train_args(data, "naive", "1", &out, extra));
     let log = ok(&as_str(&train(&["--max-strain", "1000"])));
-    assert!(log.contains("left out 0 training drapes"), "{log}");
+    assert!(
+        log.contains("training on drapes with strain p99 at most 1000% only: left out 0"),
+        "{log}"
+    );
+    // Evaluation says which drapes it used.
+    let model = out.join("last.garnet");
+    let eval = |extra: &[&str]| {
+        let mut a = vec!["eval", "--data", s(data), "--model", s(&model), "--out"];
+        a.push(s(tmp.path()));
+        a.extend_from_slice(extra);
+        owned(&a)
+    };
+    ok(&as_str(&eval(&["--max-strain", "1000"])));
+    let md = std::fs::read_to_string(tmp.path().join("results.md")).unwrap();
+    assert!(
+        md.contains("Only drapes with strain p99 at most 1000%") && md.contains("| tshirt |"),
+        "{md}"
+    );
+    let err = fails(&as_str(&eval(&["--at-rest"])));
+    assert!(
+        err.contains("no 'tshirt' sample of split 'test' is one of the drapes at rest"),
+        "{err}"
+    );
     // Five settling steps: no drape of this dataset is at rest, and every one is strained.
     let err = fails(&as_str(&train(&["--at-rest"])));
     assert!(

@@ -50,6 +50,7 @@ pub use manifest::Manifest;
 pub use merge::{merge, MergeReport};
 pub use plan::Plan;
 pub use reader::{Dataset, Sample};
+pub use records::DrapeFilter;
 pub use selection::ShardSelection;
 pub use spec::{LoadedSpec, Spec};
 pub use summary::Summary;

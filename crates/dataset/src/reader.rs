@@ -11,7 +11,7 @@ use garment::GarmentTemplate;
 use crate::error::{DatasetError, Result};
 use crate::hash::sha256_hex;
 use crate::manifest::{FileEntry, Manifest};
-use crate::records::SampleRecord;
+use crate::records::{DrapeFilter, SampleRecord};
 use crate::tensors::{self, SampleArrays};
 
 /// One stored sample: what it is and its arrays (shapes and units in
@@ -108,6 +108,21 @@ impl Dataset {
             .filter(|e| garment.is_none_or(|g| e.record.garment == g))
             .map(|e| e.record.index)
             .collect())
+    }
+
+    /// Keeps in `indices` (stored sample indices) only the samples whose drape passes
+    /// `filter`; returns how many were dropped.
+    pub fn retain_drapes(&self, indices: &mut Vec<u64>, filter: &DrapeFilter) -> usize {
+        let good: std::collections::HashSet<u64> = self
+            .manifest
+            .samples
+            .iter()
+            .filter(|e| filter.keeps(&e.record.stats))
+            .map(|e| e.record.index)
+            .collect();
+        let before = indices.len();
+        indices.retain(|i| good.contains(i));
+        before - indices.len()
     }
 
     /// The bytes of shard `s`, checked, from memory or disk.

@@ -59,6 +59,35 @@ impl From<&DrapeStats> for SimStats {
     }
 }
 
+/// Which drapes to keep by their simulator statistics (poor labels: garments that never
+/// came to rest, or were stretched far beyond what cloth does, caught on a body part).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DrapeFilter {
+    /// Keep only drapes that came to rest within the step budget.
+    pub at_rest: bool,
+    /// Keep only drapes whose strain p99 is at most this (a fraction, 0.05 = 5%).
+    pub max_strain_p99: Option<f32>,
+}
+
+impl DrapeFilter {
+    /// Whether a drape with statistics `s` passes.
+    pub fn keeps(&self, s: &SimStats) -> bool {
+        (!self.at_rest || s.converged) && self.max_strain_p99.is_none_or(|m| s.strain_p99 <= m)
+    }
+
+    /// The filter in words ("drapes at rest with strain p99 at most 5%").
+    pub fn describe(&self) -> String {
+        let mut text = String::from("drapes");
+        if self.at_rest {
+            text += " at rest";
+        }
+        if let Some(m) = self.max_strain_p99 {
+            text += &format!(" with strain p99 at most {}%", m * 100.0);
+        }
+        text
+    }
+}
+
 /// What a stored sample is.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SampleRecord {
@@ -106,4 +135,34 @@ pub struct Timing {
     pub sample_s: f64,
     /// The drape alone (the simulator's `wall_time_s`; 0 if it failed early).
     pub drape_s: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn drape_filter_keeps_what_it_says() {
+        let ok = SimStats {
+            converged: true,
+            strain_p99: 0.02,
+            ..Default::default()
+        };
+        let restless = SimStats {
+            converged: false,
+            ..ok.clone()
+        };
+        let strained = SimStats {
+            strain_p99: 0.3,
+            ..ok.clone()
+        };
+        let all = DrapeFilter::default();
+        assert!(all.keeps(&ok) && all.keeps(&restless) && all.keeps(&strained));
+        let f = DrapeFilter {
+            at_rest: true,
+            max_strain_p99: Some(0.05),
+        };
+        assert!(f.keeps(&ok) && !f.keeps(&restless) && !f.keeps(&strained));
+        assert_eq!(f.describe(), "drapes at rest with strain p99 at most 5%");
+    }
 }

@@ -208,15 +208,21 @@ mod tests {
         }
     }
 
-    #[test]
-    fn overlapping_shells_count_as_inside() {
-        let mut m = TriMesh::icosphere(2, 1.0);
-        let mut other = TriMesh::icosphere(2, 1.0);
+    /// A BVH over two overlapping unit icospheres (subdivision `sub`) centred at x = 0 and
+    /// x = 0.5.
+    fn two_spheres(sub: u32) -> Bvh {
+        let mut m = TriMesh::icosphere(sub, 1.0);
+        let mut other = TriMesh::icosphere(sub, 1.0);
         for v in &mut other.vertices {
             v.x += 0.5;
         }
         m.append(&other).unwrap();
-        let bvh = Bvh::from_mesh(&m).unwrap();
+        Bvh::from_mesh(&m).unwrap()
+    }
+
+    #[test]
+    fn overlapping_shells_count_as_inside() {
+        let bvh = two_spheres(2);
         assert!(bvh.contains(Vec3::new(0.25, 0.0, 0.0))); // inside both: winding 2
         assert!(bvh.contains(Vec3::new(-0.7, 0.0, 0.0)));
         assert!(!bvh.contains(Vec3::new(2.0, 0.0, 0.0)));
@@ -227,13 +233,7 @@ mod tests {
 
     #[test]
     fn contains_is_the_majority_of_the_three_rays() {
-        let mut m = TriMesh::icosphere(2, 1.0);
-        let mut other = TriMesh::icosphere(2, 1.0);
-        for v in &mut other.vertices {
-            v.x += 0.5;
-        }
-        m.append(&other).unwrap();
-        let bvh = Bvh::from_mesh(&m).unwrap();
+        let bvh = two_spheres(2);
         let mut rng = Rng(31);
         for _ in 0..2000 {
             let p = rng.vec3(1.6);
@@ -245,13 +245,7 @@ mod tests {
     #[test]
     fn ray_exit_leaves_every_overlapping_shell() {
         // Two unit spheres centred at x = 0 and x = 0.5 (icospheres: radius within 1% of 1).
-        let mut m = TriMesh::icosphere(3, 1.0);
-        let mut other = TriMesh::icosphere(3, 1.0);
-        for v in &mut other.vertices {
-            v.x += 0.5;
-        }
-        m.append(&other).unwrap();
-        let bvh = Bvh::from_mesh(&m).unwrap();
+        let bvh = two_spheres(3);
         let p = Vec3::new(0.25, 0.0, 0.0); // inside both
         let d = DIRS[0];
         // Along +x the first surface met is the first sphere's at x = 1, still inside the

@@ -1,0 +1,33 @@
+//! `--at-rest` and `--max-strain PCT`: which drapes of a dataset `train` and `eval` use.
+
+use anyhow::bail;
+use clap::Args;
+use dataset::DrapeFilter;
+
+/// Leave poor labels out: drapes that never came to rest, or whose garment was stretched far
+/// beyond what cloth does (caught on a body part in an extreme pose).
+#[derive(Args, Debug, Clone, Default)]
+pub struct DrapeFilterArgs {
+    /// Use only drapes that came to rest within the simulator's step budget.
+    #[arg(long)]
+    pub at_rest: bool,
+    /// Use only drapes whose strain p99 (simulator statistics) is at most this, percent.
+    #[arg(long, value_name = "PCT")]
+    pub max_strain: Option<f32>,
+}
+
+impl DrapeFilterArgs {
+    /// The filter, `None` when neither flag is given; errors on a negative or non-finite
+    /// percentage.
+    pub fn filter(&self) -> anyhow::Result<Option<DrapeFilter>> {
+        if let Some(m) = self.max_strain.filter(|m| !(m.is_finite() && *m >= 0.0)) {
+            bail!("--max-strain must be a non-negative percentage, got {m}");
+        }
+        Ok(
+            (self.at_rest || self.max_strain.is_some()).then_some(DrapeFilter {
+                at_rest: self.at_rest,
+                max_strain_p99: self.max_strain.map(|m| m / 100.0),
+            }),
+        )
+    }
+}
