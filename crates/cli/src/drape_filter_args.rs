@@ -2,7 +2,7 @@
 
 use anyhow::bail;
 use clap::Args;
-use dataset::DrapeFilter;
+use dataset::{Dataset, DrapeFilter};
 
 /// Leave poor labels out: drapes that never came to rest, or whose garment was stretched far
 /// beyond what cloth does (caught on a body part in an extreme pose).
@@ -30,4 +30,27 @@ impl DrapeFilterArgs {
             }),
         )
     }
+}
+
+/// Keeps in `indices` (the `garment` samples of `split` in `data`) only the drapes `filter`
+/// passes; returns how many were dropped. Errors, naming the dataset and the filter, when
+/// none is left.
+pub fn keep_drapes(
+    data: &Dataset,
+    split: &str,
+    garment: &str,
+    indices: &mut Vec<u64>,
+    filter: &DrapeFilter,
+) -> anyhow::Result<usize> {
+    let before = indices.len();
+    let dropped = data.retain_drapes(indices, filter);
+    if indices.is_empty() {
+        bail!(
+            "{}: no '{garment}' sample of split '{split}' is one of the {} (none of the {before} \
+             samples is; --at-rest, --max-strain)",
+            data.dir().display(),
+            filter.describe()
+        );
+    }
+    Ok(dropped)
 }

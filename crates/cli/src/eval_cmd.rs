@@ -7,7 +7,7 @@ use std::collections::{BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::{anyhow, bail, Context};
+use anyhow::{anyhow, Context};
 use body::{BodyModel, Phenotype, Pose, Skinning};
 use clap::Args;
 use dataset::batches::{BatchOptions, Batches, Order};
@@ -20,7 +20,7 @@ use render::plot::{Chart, Series};
 use serde::Serialize;
 
 use crate::drape_cmd::checkpoint_template;
-use crate::drape_filter_args::DrapeFilterArgs;
+use crate::drape_filter_args::{keep_drapes, DrapeFilterArgs};
 use crate::model_device::DeviceArg;
 use crate::simulate_cmd::write_json;
 
@@ -241,14 +241,7 @@ impl EvalData {
         let garment = matching_garment(data, split, &template.mesh)?;
         let mut indices = data.select(Some(split), Some(&garment))?;
         if let Some(f) = filter {
-            data.retain_drapes(&mut indices, f);
-            if indices.is_empty() {
-                bail!(
-                    "{}: no '{garment}' sample of split '{split}' is one of the {}",
-                    data.dir().display(),
-                    f.describe()
-                );
-            }
+            keep_drapes(data, split, &garment, &mut indices, f)?;
         }
         if let Some(n) = max_samples {
             indices.truncate(n);

@@ -8,14 +8,14 @@ use anyhow::{bail, Context};
 use burn::module::Module;
 use clap::{Args, ValueEnum};
 use dataset::batches::{BatchOptions, Batches, Order};
-use dataset::{Dataset, DrapeFilter};
+use dataset::Dataset;
 use indicatif::{ProgressBar, ProgressStyle};
 use model::{
     BodyTopology, CosineSchedule, GarNetConfig, LossConfig, ModelSetup, Sample, Trainer, Variant,
     PAPER_LEARNING_RATE,
 };
 
-use crate::drape_filter_args::DrapeFilterArgs;
+use crate::drape_filter_args::{keep_drapes, DrapeFilterArgs};
 use crate::model_device::DeviceArg;
 
 /// Arguments of `garnet train`.
@@ -143,21 +143,6 @@ impl<'a> GarmentSplit<'a> {
         })
     }
 
-    /// Keeps only the samples whose drape passes `filter`. Returns how many were dropped;
-    /// errors when none is left.
-    pub fn keep_drapes(&mut self, filter: &DrapeFilter) -> anyhow::Result<usize> {
-        let before = self.indices.len();
-        let dropped = self.data.retain_drapes(&mut self.indices, filter);
-        if self.indices.is_empty() {
-            bail!(
-                "{}: none of the {before} samples is one of the {} (--at-rest, --max-strain)",
-                self.data.dir().display(),
-                filter.describe()
-            );
-        }
-        Ok(dropped)
-    }
-
     /// The garment template the samples share (metres).
     pub fn template(&self) -> anyhow::Result<std::sync::Arc<garment::GarmentTemplate>> {
         let first = self.data.sample(self.indices[0])?;
@@ -202,7 +187,7 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
     let data = Dataset::open(&args.data)?;
     let mut train = GarmentSplit::new(&data, "train", &args.garment)?;
     if let Some(filter) = args.drapes.filter()? {
-        let dropped = train.keep_drapes(&filter)?;
+        let dropped = keep_drapes(&data, "train", &args.garment, &mut train.indices, &filter)?;
         eprintln!(
             "training on {} only: left out {dropped} training drapes",
             filter.describe()

@@ -113,15 +113,12 @@ impl Dataset {
     /// Keeps in `indices` (stored sample indices) only the samples whose drape passes
     /// `filter`; returns how many were dropped.
     pub fn retain_drapes(&self, indices: &mut Vec<u64>, filter: &DrapeFilter) -> usize {
-        let good: std::collections::HashSet<u64> = self
-            .manifest
-            .samples
-            .iter()
-            .filter(|e| filter.keeps(&e.record.stats))
-            .map(|e| e.record.index)
-            .collect();
         let before = indices.len();
-        indices.retain(|i| good.contains(i));
+        indices.retain(|&k| {
+            self.manifest
+                .sample(k)
+                .is_some_and(|e| filter.keeps(&e.record.stats))
+        });
         before - indices.len()
     }
 

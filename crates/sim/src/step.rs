@@ -370,8 +370,17 @@ fn project_out(
                 return None;
             }
             let xi = x1[i];
-            let fix = proj.vertex(xi, x0[i], dist0[i]);
-            if check == Check::Exact && c.contains_cur(fix.map_or(xi, |f| f.0)) {
+            let verdict = proj.vertex(xi, x0[i], dist0[i]);
+            let fix = match verdict {
+                Verdict::Move(target, out) => Some((target, out)),
+                Verdict::Clear | Verdict::Outside => None,
+            };
+            // The exact pass checks the final place by the winding test, unless the
+            // projection already found it outside that way.
+            if check == Check::Exact
+                && verdict != Verdict::Outside
+                && c.contains_cur(fix.map_or(xi, |f| f.0))
+            {
                 if let Some((target, out)) = c.exit_point(xi, to) {
                     return Some(Fix {
                         i,
@@ -391,6 +400,17 @@ fn project_out(
         .collect()
 }
 
+/// What the projection decided for one vertex.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Verdict {
+    /// Clear of the body by its closest surface (or not looked at: too far to reach it).
+    Clear,
+    /// Outside the body by the winding test.
+    Outside,
+    /// Goes to this place, moved out along this unit direction.
+    Move(Vec3, Vec3),
+}
+
 /// What the projection of one vertex reads.
 struct Projection<'a> {
     c: &'a BodyCollider,
@@ -406,26 +426,32 @@ struct Projection<'a> {
 
 impl Projection<'_> {
     /// Where a vertex at `xi` that started the step at `x0`, at least `dist0` metres from
-    /// the body, goes and the outward direction; `None` when it is outside and clear.
-    fn vertex(&self, xi: Vec3, x0: Vec3, dist0: f32) -> Option<(Vec3, Vec3)> {
+    /// the body, goes and the outward direction, or why it stays.
+    fn vertex(&self, xi: Vec3, x0: Vec3, dist0: f32) -> Verdict {
         let (c, reach, full) = (self.c, self.reach, self.full);
         let travel = (xi - x0).length() + self.max_disp;
         // Far from the body at the start and not moved enough to reach it: no query
         // (the distance at the end is at least the start distance minus the travel).
         if !full && dist0 - travel > reach {
-            return None;
+            return Verdict::Clear;
         }
         let hit = match c.surface_within(xi, reach) {
             Some(hit) => hit,
             None => {
-                if (!full && travel < dist0) || !c.contains_cur(xi) {
-                    return None;
+                if !full && travel < dist0 {
+                    return Verdict::Clear;
                 }
-                c.surface_any(xi)?
+                if !c.contains_cur(xi) {
+                    return Verdict::Outside;
+                }
+                match c.surface_any(xi) {
+                    Some(hit) => hit,
+                    None => return Verdict::Clear,
+                }
             }
         };
         if hit.signed >= self.to {
-            return None;
+            return Verdict::Clear;
         }
         // Under the closest surface yet outside the body: a fold of the skin (a posed
         // crease passing through itself). Pushing out of that surface would push the
@@ -433,9 +459,10 @@ impl Projection<'_> {
         // three ray casts, so only the full checks ask it (one per step cost 7-15% of
         // the 1 cm T-shirt's drape time); the exact pass at the end is one of them.
         if full && hit.signed < 0.0 && !c.contains_cur(xi) {
-            return None;
+            return Verdict::Outside;
         }
-        Some(clear_of_overlaps(c, hit, reach, self.to))
+        let (target, out) = clear_of_overlaps(c, hit, reach, self.to);
+        Verdict::Move(target, out)
     }
 }
 
