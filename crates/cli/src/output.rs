@@ -46,6 +46,39 @@ pub fn render_views(
     )?)
 }
 
+/// Strain at which the strain map is red, percent.
+pub const STRAIN_MAP_MAX_PCT: f32 = 10.0;
+
+/// Saves a strain map: front, side and back views (`size` pixels each) of the body in skin
+/// colour and the garment coloured by `vertex_strain` (`[N]`, 0.01 = 1%: blue at 0 or less,
+/// red at [`STRAIN_MAP_MAX_PCT`] or more), with a legend.
+pub fn write_strain_png(
+    path: &Path,
+    body: &TriMesh,
+    garment: &TriMesh,
+    vertex_strain: &[f32],
+    size: (u32, u32),
+) -> anyhow::Result<()> {
+    create_parent(path)?;
+    let colors = render::palette::heat_colors(vertex_strain, 0.0, STRAIN_MAP_MAX_PCT / 100.0);
+    let scene = [
+        RenderMesh::new(&body.vertices, &body.faces, render::palette::SKIN),
+        RenderMesh::new(&garment.vertices, &garment.faces, [0; 3]).with_vertex_colors(&colors),
+    ];
+    let mut image = render::render_views(&scene, &[View::Front, View::Side, View::Back], size)?;
+    let legend = render::palette::heat_legend(
+        size.0 / 2,
+        "strain 0%",
+        &format!("{STRAIN_MAP_MAX_PCT:.0}%"),
+    );
+    image.blit(&legend, 16, 16);
+    image
+        .save_png(path)
+        .with_context(|| format!("writing {}", path.display()))?;
+    eprintln!("wrote {}", path.display());
+    Ok(())
+}
+
 /// Creates the parent directory of `path` if it is missing.
 pub fn create_parent(path: &Path) -> anyhow::Result<()> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {

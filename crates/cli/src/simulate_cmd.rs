@@ -13,7 +13,7 @@ use sim::drape::{drape, DrapeOptions};
 
 use crate::body_cmd::SkinningArg;
 use crate::garment_cmd::garment_color;
-use crate::output::{create_parent, write_mesh, write_png};
+use crate::output::{create_parent, write_mesh, write_png, write_strain_png};
 use crate::pose_args::PoseArgs;
 use crate::shape_args::ShapeArgs;
 
@@ -42,6 +42,10 @@ pub struct SimulateArgs {
     /// Also write a picture of the draped garment on the body.
     #[arg(long, value_name = "FILE.png")]
     pub png: Option<PathBuf>,
+    /// Also write a strain map: the garment coloured by how far its edges are stretched
+    /// (blue 0%, red 10% or more), front, side and back.
+    #[arg(long, value_name = "FILE.png")]
+    pub strain_png: Option<PathBuf>,
     /// Write the animation as meshes into this folder (garment_NNNN.obj, body_NNNN.obj).
     #[arg(long, value_name = "DIR")]
     pub frames: Option<PathBuf>,
@@ -147,6 +151,15 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
                 (&result.body, palette::SKIN),
                 (&result.garment, garment_color(&template.kind)),
             ],
+            (480, 720),
+        )?;
+    }
+    if let Some(png) = &args.strain_png {
+        write_strain_png(
+            png,
+            &result.body,
+            &result.garment,
+            &result.vertex_strain,
             (480, 720),
         )?;
     }

@@ -299,7 +299,21 @@ fn simulate_drapes_a_template_and_reports_statistics() {
         s(&frames),
         "--frames-every",
         "50",
+        "--strain-png",
+        s(&p("strain.png")),
     ]);
+    // The strain map: three views, the garment in heat colours (blue where unstretched,
+    // as nearly all of a shirt at rest; black if its vertex colours were lost).
+    let map = render::Image::from_png(p("strain.png")).unwrap();
+    assert_eq!((map.width, map.height), (3 * 480, 720));
+    let blue = (0..map.height)
+        .flat_map(|y| (0..map.width).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let [r, g, b] = map.pixel(x, y);
+            b as i32 > r as i32 + 60 && b > g
+        })
+        .count();
+    assert!(blue > 5000, "{blue} blue pixels");
     let draped = geom::io::read_mesh(&out).unwrap();
     let template = garment::GarmentTemplate::load(&p("t.garment")).unwrap();
     assert_eq!(

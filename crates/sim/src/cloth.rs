@@ -327,4 +327,9 @@ impl ClothSim {
     pub fn strains(&self) -> Vec<f32> {
         self.cons.strains(&self.x)
     }
+
+    /// Vertex strains `[N]`: the largest strain of each vertex's edges (0 without edges).
+    pub fn vertex_strains(&self) -> Vec<f32> {
+        self.cons.vertex_strains(&self.x)
+    }
 }

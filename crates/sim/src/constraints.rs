@@ -188,6 +188,19 @@ impl Constraints {
             .collect()
     }
 
+    /// Strain of each vertex `[N]`: the largest strain (length / rest - 1) of its stretch
+    /// edges at positions `x` (`[N]`); 0 for a vertex without edges.
+    pub fn vertex_strains(&self, x: &[Vec3]) -> Vec<f32> {
+        let mut out = vec![0.0f32; self.mass.len()];
+        let edges = self.pairs[..self.n_stretch].iter();
+        for (&[a, b], s) in edges.zip(self.strains(x)) {
+            for v in [a as usize, b as usize] {
+                out[v] = out[v].max(s);
+            }
+        }
+        out
+    }
+
     /// Sum of the stretch weights at each vertex (`[N]`, N/m): the scale of the cloth's
     /// stiffness there.
     pub fn stretch_diag(&self) -> Vec<f64> {
@@ -225,5 +238,25 @@ mod tests {
         assert!(c.energy(&x).abs() < 1e-15);
         assert!(c.strains(&m.vertices).iter().all(|s| s.abs() < 1e-6));
         assert_eq!(c.incident.len(), 2 * c.pairs.len());
+    }
+
+    #[test]
+    fn vertex_strain_is_the_largest_of_its_edges() {
+        let m = TriMesh::grid(4, 3, 0.1);
+        let c = Constraints::new(&m.vertices, &m.faces, &ClothParams::default()).unwrap();
+        let scaled = |sx: f32| -> Vec<Vec3> {
+            m.vertices
+                .iter()
+                .map(|v| Vec3::new(v.x * sx, v.y, v.z))
+                .collect()
+        };
+        // Stretched 10% along x: every vertex has an edge along x, diagonals stretch less.
+        for s in c.vertex_strains(&scaled(1.1)) {
+            assert!((s - 0.1).abs() < 1e-5, "{s}");
+        }
+        // Compressed along x: the largest is the unchanged edge along z.
+        for s in c.vertex_strains(&scaled(0.9)) {
+            assert!(s.abs() < 1e-6, "{s}");
+        }
     }
 }

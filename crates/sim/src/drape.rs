@@ -92,6 +92,9 @@ pub struct Drape {
     pub body: TriMesh,
     /// The pose the body took: the target pose after the limb clearance correction.
     pub pose: Pose,
+    /// `[N]` the largest strain (length / rest - 1) of each garment vertex's edges at the
+    /// end: where the cloth is stretched.
+    pub vertex_strain: Vec<f32>,
     /// What the drape took and reached.
     pub stats: DrapeStats,
 }
@@ -257,6 +260,7 @@ pub fn drape(
             faces: target.mesh.faces.clone(),
         },
         pose,
+        vertex_strain: sim.vertex_strains(),
         stats,
     })
 }
