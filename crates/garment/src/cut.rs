@@ -96,7 +96,7 @@ impl CutParams {
             GarmentKind::Sweater => Self {
                 body_length: 0.6,
                 sleeve_length: 0.46,
-                ease: 0.04,
+                ease: 0.05,
                 neckline_depth: 0.02,
                 ..Self::TSHIRT
             },
@@ -111,7 +111,7 @@ impl CutParams {
     const TSHIRT: Self = Self {
         body_length: 0.59,
         sleeve_length: 0.28,
-        ease: 0.03,
+        ease: 0.04,
         neckline_depth: 0.04,
         waist_height: 0.04,
         leg_length: 0.75,
