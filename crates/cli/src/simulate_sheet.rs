@@ -169,13 +169,13 @@ fn short(what: &str) -> String {
 /// A Markdown table of the cases and a summary line.
 fn markdown(cases: &[Case]) -> String {
     let mut out = String::from(
-        "| garment | shape | pose | time (s) | steps | at rest | max pen. (mm) | strain p99 (%) | limbs turned (deg) | walked out |\n|---|---|---|---:|---:|---|---:|---:|---:|---:|\n",
+        "| garment | shape | pose | time (s) | steps | at rest | max pen. (mm) | strain p99 (%) | slid (cm) | limbs turned (deg) | walked out |\n|---|---|---|---:|---:|---|---:|---:|---:|---:|---:|\n",
     );
     for c in cases {
         match &c.stats {
             Some(s) => {
                 out += &format!(
-                    "| {} | {} | {} | {:.2} | {} | {} | {:.2} | {:.2} | {:.0} | {} |\n",
+                    "| {} | {} | {} | {:.2} | {} | {} | {:.2} | {:.2} | {:.1} | {:.0} | {} |\n",
                     c.garment,
                     c.shape_seed,
                     c.pose,
@@ -184,13 +184,14 @@ fn markdown(cases: &[Case]) -> String {
                     if s.converged { "yes" } else { "no" },
                     s.max_penetration_m * 1e3,
                     s.strain_p99 * 100.0,
+                    s.slid_m * 100.0,
                     s.limb_turn_deg,
                     s.walked_out
                 )
             }
             None => {
                 out += &format!(
-                    "| {} | {} | {} | failed: {} | | | | | | |\n",
+                    "| {} | {} | {} | failed: {} | | | | | | | |\n",
                     c.garment,
                     c.shape_seed,
                     c.pose,

@@ -38,6 +38,10 @@ pub struct SimStats {
     /// overlapping body parts; see `sim::stats::DrapeStats::walked_out`).
     #[serde(default)]
     pub walked_out: u32,
+    /// How far the garment slid on the body, metres (`sim::stats::DrapeStats::slid_m`);
+    /// absent in samples made before it was measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slid_m: Option<f32>,
 }
 
 impl From<&DrapeStats> for SimStats {
@@ -55,6 +59,7 @@ impl From<&DrapeStats> for SimStats {
             converged: s.converged,
             limb_turn_deg: s.limb_turn_deg,
             walked_out: s.walked_out,
+            slid_m: Some(s.slid_m),
         }
     }
 }
@@ -164,5 +169,24 @@ mod tests {
         };
         assert!(f.keeps(&ok) && !f.keeps(&restless) && !f.keeps(&strained));
         assert_eq!(f.describe(), "drapes at rest with strain p99 at most 5%");
+    }
+
+    #[test]
+    fn records_made_before_the_slide_was_measured_read_and_write_as_before() {
+        let old = SimStats {
+            converged: true,
+            ..Default::default()
+        };
+        let text = serde_json::to_string(&old).unwrap();
+        assert!(!text.contains("slid_m"), "{text}");
+        let back: SimStats = serde_json::from_str(&text).unwrap();
+        assert_eq!(back.slid_m, None);
+        let new = SimStats::from(&DrapeStats {
+            slid_m: 0.04,
+            ..Default::default()
+        });
+        let text = serde_json::to_string(&new).unwrap();
+        let back: SimStats = serde_json::from_str(&text).unwrap();
+        assert_eq!(back.slid_m, Some(0.04));
     }
 }

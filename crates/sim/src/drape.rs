@@ -148,9 +148,9 @@ pub fn drape(
     };
     let (yaw, mut calm) = remove_root_yaw(target, &pose);
     calm.rotations.iter_mut().for_each(|q| *q = q.normalize());
+    let anchors = SurfaceAnchors::new(&template.mesh, &template_body.mesh)
+        .map_err(|e| SimError::InvalidInput(e.to_string()))?;
     let mut sim = if opts.grade {
-        let anchors = SurfaceAnchors::new(&template.mesh, &template_body.mesh)
-            .map_err(|e| SimError::InvalidInput(e.to_string()))?;
         let graded = TriMesh {
             vertices: anchors.place(&target.mesh),
             faces: template.mesh.faces.clone(),
@@ -233,6 +233,13 @@ pub fn drape(
         final_kinetic_energy: sim.kinetic_energy(),
         converged,
         limb_turn_deg,
+        slid_m: mean_distance(
+            sim.positions(),
+            &anchors.place(&TriMesh {
+                vertices: body.clone(),
+                faces: target.mesh.faces.clone(),
+            }),
+        ),
         ..Default::default()
     };
     stats.measure(
@@ -303,6 +310,13 @@ fn remove_root_yaw(target: &ShapedBody, pose: &Pose) -> (Quat, Pose) {
     let mut calm = pose.clone();
     calm.rotations[0] = root.frame.inverse() * tilt * root.frame;
     (yaw, calm)
+}
+
+/// Mean distance between corresponding points of `a` and `b` (`[N]` each), metres; 0 for
+/// none.
+fn mean_distance(a: &[Vec3], b: &[Vec3]) -> f32 {
+    let sum: f64 = a.iter().zip(b).map(|(p, q)| p.distance(*q) as f64).sum();
+    (sum / a.len().max(1) as f64) as f32
 }
 
 /// Total mass of a cloth mesh of `density` kg/m^2.

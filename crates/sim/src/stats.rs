@@ -38,6 +38,14 @@ pub struct DrapeStats {
     /// caught again counts again). Each can leave a spike in the cloth.
     #[serde(default)]
     pub walked_out: u32,
+    /// How far the garment slid on the body: the mean distance, metres, between its
+    /// vertices and where the template's surface anchors put them on the final body (the
+    /// template carried along with the skin). A garment hanging where it was fitted moves
+    /// about its ease as it settles onto the body (4 cm for the T-shirt at rest on its own
+    /// body); one that slid down or off the body (jeans pulled below the hips) shows twice
+    /// that or more (17 cm).
+    #[serde(default)]
+    pub slid_m: f32,
 }
 
 /// The value at quantile `q` in [0, 1] of `values` (nearest rank; 0 for none).
@@ -66,7 +74,7 @@ impl DrapeStats {
     /// One line for people: time, steps, energy, penetration in mm, strain in percent.
     pub fn summary(&self) -> String {
         format!(
-            "{:.2} s, {} + {} steps, KE {:.2e} J, {}, penetration max {:.2} mm p99 {:.2} mm, strain p50 {:.2}% p99 {:.2}% max {:.2}%, limbs turned {:.0} deg",
+            "{:.2} s, {} + {} steps, KE {:.2e} J, {}, penetration max {:.2} mm p99 {:.2} mm, strain p50 {:.2}% p99 {:.2}% max {:.2}%, slid {:.1} cm, limbs turned {:.0} deg",
             self.wall_time_s,
             self.animation_steps,
             self.settle_steps,
@@ -77,6 +85,7 @@ impl DrapeStats {
             self.strain_p50 * 100.0,
             self.strain_p99 * 100.0,
             self.strain_max * 100.0,
+            self.slid_m * 100.0,
             self.limb_turn_deg
         ) + &match self.walked_out {
             0 => String::new(),
