@@ -4,8 +4,8 @@ use anyhow::bail;
 use clap::Args;
 use dataset::{Dataset, DrapeFilter};
 
-/// Leave poor labels out: drapes that never came to rest, or whose garment was stretched far
-/// beyond what cloth does (caught on a body part in an extreme pose).
+/// Leave poor labels out: drapes that never came to rest, whose garment was stretched far
+/// beyond what cloth does (caught on a body part in an extreme pose), or slid down the body.
 #[derive(Args, Debug, Clone, Default)]
 pub struct DrapeFilterArgs {
     /// Use only drapes that came to rest within the simulator's step budget.
@@ -14,6 +14,10 @@ pub struct DrapeFilterArgs {
     /// Use only drapes whose strain p99 (simulator statistics) is at most this, percent.
     #[arg(long, value_name = "PCT")]
     pub max_strain: Option<f32>,
+    /// Use only drapes whose garment slid at most this far on the body, cm (simulator
+    /// statistics; drapes made before it was recorded are kept).
+    #[arg(long, value_name = "CM")]
+    pub max_slide: Option<f32>,
 }
 
 impl DrapeFilterArgs {
@@ -23,12 +27,15 @@ impl DrapeFilterArgs {
         if let Some(m) = self.max_strain.filter(|m| !(m.is_finite() && *m >= 0.0)) {
             bail!("--max-strain must be a non-negative percentage, got {m}");
         }
-        Ok(
-            (self.at_rest || self.max_strain.is_some()).then_some(DrapeFilter {
-                at_rest: self.at_rest,
-                max_strain_p99: self.max_strain.map(|m| m / 100.0),
-            }),
-        )
+        if let Some(m) = self.max_slide.filter(|m| !(m.is_finite() && *m >= 0.0)) {
+            bail!("--max-slide must be a non-negative distance in cm, got {m}");
+        }
+        let any = self.at_rest || self.max_strain.is_some() || self.max_slide.is_some();
+        Ok(any.then_some(DrapeFilter {
+            at_rest: self.at_rest,
+            max_strain_p99: self.max_strain.map(|m| m / 100.0),
+            max_slid_m: self.max_slide.map(|m| m / 100.0),
+        }))
     }
 }
 
@@ -47,7 +54,7 @@ pub fn keep_drapes(
     if indices.is_empty() {
         bail!(
             "{}: no '{garment}' sample of split '{split}' is one of the {} (none of the {before} \
-             samples is; --at-rest, --max-strain)",
+             samples is; --at-rest, --max-strain, --max-slide)",
             data.dir().display(),
             filter.describe()
         );

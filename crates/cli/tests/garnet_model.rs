@@ -252,6 +252,15 @@ fn train_and_eval_leave_out_drapes_not_at_rest_or_overstretched() {
     assert!(err.contains("strain p99 at most 0%"), "{err}");
     let err = fails(&as_str(&train(&["--max-strain=-1"])));
     assert!(err.contains("--max-strain"), "{err}");
+    // Every garment settles onto the body a little: none slid 0 cm, all under 10 m.
+    let err = fails(&as_str(&train(&["--max-slide", "0"])));
+    assert!(
+        err.contains("whose garment slid at most 0 cm") && err.contains("--max-slide"),
+        "{err}"
+    );
+    ok(&as_str(&eval(&["--max-slide", "1000"])));
+    let err = fails(&as_str(&train(&["--max-slide=-1"])));
+    assert!(err.contains("--max-slide"), "{err}");
 }
 
 #[test]

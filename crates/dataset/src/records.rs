@@ -65,19 +65,27 @@ impl From<&DrapeStats> for SimStats {
 }
 
 /// Which drapes to keep by their simulator statistics (poor labels: garments that never
-/// came to rest, or were stretched far beyond what cloth does, caught on a body part).
+/// came to rest, were stretched far beyond what cloth does, caught on a body part, or slid
+/// down the body).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct DrapeFilter {
     /// Keep only drapes that came to rest within the step budget.
     pub at_rest: bool,
     /// Keep only drapes whose strain p99 is at most this (a fraction, 0.05 = 5%).
     pub max_strain_p99: Option<f32>,
+    /// Keep only drapes whose garment slid at most this far on the body (metres,
+    /// [`SimStats::slid_m`]); drapes made before the slide was measured are kept.
+    pub max_slid_m: Option<f32>,
 }
 
 impl DrapeFilter {
     /// Whether a drape with statistics `s` passes.
     pub fn keeps(&self, s: &SimStats) -> bool {
-        (!self.at_rest || s.converged) && self.max_strain_p99.is_none_or(|m| s.strain_p99 <= m)
+        (!self.at_rest || s.converged)
+            && self.max_strain_p99.is_none_or(|m| s.strain_p99 <= m)
+            && self
+                .max_slid_m
+                .is_none_or(|m| s.slid_m.is_none_or(|d| d <= m))
     }
 
     /// The filter in words ("drapes at rest with strain p99 at most 5%").
@@ -88,6 +96,14 @@ impl DrapeFilter {
         }
         if let Some(m) = self.max_strain_p99 {
             text += &format!(" with strain p99 at most {}%", m * 100.0);
+        }
+        if let Some(m) = self.max_slid_m {
+            let and = if self.max_strain_p99.is_some() {
+                " and"
+            } else {
+                ""
+            };
+            text += &format!("{and} whose garment slid at most {} cm", m * 100.0);
         }
         text
     }
@@ -166,9 +182,24 @@ mod tests {
         let f = DrapeFilter {
             at_rest: true,
             max_strain_p99: Some(0.05),
+            max_slid_m: None,
         };
         assert!(f.keeps(&ok) && !f.keeps(&restless) && !f.keeps(&strained));
         assert_eq!(f.describe(), "drapes at rest with strain p99 at most 5%");
+        let slid = |d: Option<f32>| SimStats {
+            slid_m: d,
+            ..ok.clone()
+        };
+        let g = DrapeFilter {
+            max_slid_m: Some(0.1),
+            ..f
+        };
+        assert!(g.keeps(&slid(Some(0.04))) && g.keeps(&slid(None)));
+        assert!(!g.keeps(&slid(Some(0.17))) && !g.keeps(&restless));
+        assert_eq!(
+            g.describe(),
+            "drapes at rest with strain p99 at most 5% and whose garment slid at most 10 cm"
+        );
     }
 
     #[test]
