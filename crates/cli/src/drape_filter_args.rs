@@ -39,6 +39,21 @@ impl DrapeFilterArgs {
     }
 }
 
+/// The command-line flags that give `filter`, each after a space (" --at-rest --max-strain 5").
+pub fn filter_flags(filter: &DrapeFilter) -> String {
+    let mut flags = String::new();
+    if filter.at_rest {
+        flags += " --at-rest";
+    }
+    if let Some(m) = filter.max_strain_p99 {
+        flags += &format!(" --max-strain {}", m * 100.0);
+    }
+    if let Some(m) = filter.max_slid_m {
+        flags += &format!(" --max-slide {}", m * 100.0);
+    }
+    flags
+}
+
 /// Keeps in `indices` (the `garment` samples of `split` in `data`) only the drapes `filter`
 /// passes; returns how many were dropped. Errors, naming the dataset and the filter, when
 /// none is left.
@@ -60,4 +75,21 @@ pub fn keep_drapes(
         );
     }
     Ok(dropped)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn flags_give_back_the_filter() {
+        let args = DrapeFilterArgs {
+            at_rest: true,
+            max_strain: Some(5.0),
+            max_slide: Some(10.0),
+        };
+        let f = args.filter().unwrap().unwrap();
+        assert_eq!(filter_flags(&f), " --at-rest --max-strain 5 --max-slide 10");
+        assert_eq!(DrapeFilterArgs::default().filter().unwrap(), None);
+    }
 }

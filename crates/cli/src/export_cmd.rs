@@ -11,6 +11,9 @@ use burn::module::Module;
 use clap::Args;
 use model::{load_checkpoint, save_checkpoint, Checkpoint};
 
+use dataset::DrapeFilter;
+
+use crate::drape_filter_args::{filter_flags, DrapeFilterArgs};
 use crate::eval_cmd::{EvalData, ModelEvaluation};
 use crate::model_device::DeviceArg;
 
@@ -32,6 +35,10 @@ pub struct ExportArgs {
     /// Model file to write (`.garnet`); the card goes beside it with the extension `.md`.
     #[arg(long, value_name = "FILE.garnet")]
     pub out: PathBuf,
+    /// The drapes the model was trained on (`garnet train`'s filter): the card counts them
+    /// and adds the metrics on the test drapes that pass it.
+    #[command(flatten)]
+    pub drapes: DrapeFilterArgs,
 }
 
 /// Runs `garnet export`.
@@ -49,6 +56,14 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
     save_checkpoint(&args.out, &network, None, &ck.setup, &ck.loss, &ck.state)?;
     let data = EvalData::open(&args.data)?;
     let eval = data.evaluate(&args.out, &args.split, None, args.max_samples, &device)?;
+    let filter = args.drapes.filter()?;
+    let filtered = match &filter {
+        Some(f) => {
+            let e = data.evaluate(&args.out, &args.split, Some(f), args.max_samples, &device)?;
+            Some((*f, e))
+        }
+        None => None,
+    };
     let card = model_card(
         &args.model,
         &args.out,
@@ -57,6 +72,7 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
         &data,
         &args.split,
         &eval,
+        filtered.as_ref(),
     )?;
     let card_path = args.out.with_extension("md");
     geom::io::write_bytes_atomic(&card_path, card.as_bytes())?;
@@ -69,7 +85,9 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The model card (Markdown) of the exported model at `path`.
+/// The model card (Markdown) of the exported model at `path`; `filtered`: the filter of
+/// the drapes it was trained on and its evaluation on the test drapes that pass it.
+#[allow(clippy::too_many_arguments)]
 fn model_card(
     source: &Path,
     path: &Path,
@@ -78,6 +96,7 @@ fn model_card(
     data: &EvalData,
     split: &str,
     eval: &ModelEvaluation,
+    filtered: Option<&(DrapeFilter, ModelEvaluation)>,
 ) -> anyhow::Result<String> {
     let setup = &ck.setup;
     let cfg = &setup.config;
@@ -86,10 +105,20 @@ fn model_card(
     let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("model");
     let size_mb = std::fs::metadata(path)?.len() as f64 / 1e6;
     let manifest = data.dataset().manifest();
-    let train = data
-        .dataset()
-        .select(Some("train"), Some(&eval.garment))?
-        .len();
+    let mut train_indices = data.dataset().select(Some("train"), Some(&eval.garment))?;
+    let train_all = train_indices.len();
+    let train = match filtered {
+        Some((f, _)) => {
+            data.dataset().retain_drapes(&mut train_indices, f);
+            format!(
+                "{} training samples of this garment, trained on the {} of them that are {}",
+                train_all,
+                train_indices.len(),
+                f.describe()
+            )
+        }
+        None => format!("{train_all} training samples of this garment"),
+    };
     let [net, dqs] = eval.summary();
     let (net_ms, sim_s) = eval.times();
     let mut md = format!(
@@ -107,8 +136,8 @@ fn model_card(
     );
     md += &format!(
         "## Training\n\n\
-         - dataset: '{ds}' (`{dir}`, spec `{dir}/spec.toml`), {train} training samples of this \
-         garment; validation on its 'val' split\n\
+         - dataset: '{ds}' (`{dir}`, spec `{dir}/spec.toml`), {train}; validation on its \
+         'val' split\n\
          - command: `{cmd}`\n\
          - progress: {ep} epochs, {st} steps, last learning rate {lr:.1e}; best validation E_dist \
          {best}\n\
@@ -152,10 +181,19 @@ fn model_card(
          | method | samples | E_dist (cm) | E_norm (deg) | vertices inside the body |\n\
          |---|---:|---:|---:|---:|\n"
     );
-    for (method, (samples, dist, norm, inside)) in [
+    let mut rows = vec![
         (format!("GarNet-{}", cfg.variant.name()), net),
         ("DQS warp (the input M)".to_string(), dqs),
-    ] {
+    ];
+    if let Some((f, e)) = filtered {
+        let [net, dqs] = e.summary();
+        rows.push((
+            format!("GarNet-{}, {}", cfg.variant.name(), f.describe()),
+            net,
+        ));
+        rows.push((format!("DQS warp, {}", f.describe()), dqs));
+    }
+    for (method, (samples, dist, norm, inside)) in rows {
         md += &format!(
             "| {method} | {samples} | {dist:.2} | {norm:.1} | {:.1}% |\n",
             inside * 100.0
@@ -169,10 +207,11 @@ fn model_card(
         ))
     );
     md += &format!(
-        "\nMade by `garnet export --model {} --data {} --out {}`.\n",
+        "\nMade by `garnet export --model {} --data {} --out {}{}`.\n",
         source.display(),
         data.dataset().dir().display(),
-        path.display()
+        path.display(),
+        filtered.map_or(String::new(), |(f, _)| filter_flags(f))
     );
     Ok(md)
 }

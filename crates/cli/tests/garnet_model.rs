@@ -151,6 +151,8 @@ fn train_resume_eval_and_drape() {
             s(data),
             "--out",
             s(out),
+            "--max-strain",
+            "1000",
         ])
     };
     assert!(export(&shipped).status.success());
@@ -170,6 +172,11 @@ fn train_resume_eval_and_drape() {
         "| DQS warp (the input M) |",
         "best validation E_dist",
         "learning rate by epoch (from the run's metrics.csv): 1.0e-3 (epochs 1-3)",
+        // The drapes it was trained on (the filter given to export), and its metrics on them.
+        "trained on the 2 of them that are drapes with strain p99 at most 1000%",
+        "| GarNet-local, drapes with strain p99 at most 1000% |",
+        "| DQS warp, drapes with strain p99 at most 1000% |",
+        "--max-strain 1000`.",
     ] {
         assert!(card.contains(needle), "{needle} missing:\n{card}");
     }
