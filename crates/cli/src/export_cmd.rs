@@ -46,6 +46,7 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
     if args.out.extension().and_then(|e| e.to_str()) != Some("garnet") {
         bail!("{}: the model file must end in .garnet", args.out.display());
     }
+    let filter = args.drapes.filter()?;
     let ck = load_checkpoint(&args.model)
         .with_context(|| format!("loading {}", args.model.display()))?;
     let device = DeviceArg::Cpu.device()?;
@@ -56,11 +57,10 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
     save_checkpoint(&args.out, &network, None, &ck.setup, &ck.loss, &ck.state)?;
     let data = EvalData::open(&args.data)?;
     let eval = data.evaluate(&args.out, &args.split, None, args.max_samples, &device)?;
-    let filter = args.drapes.filter()?;
-    let filtered = match &filter {
+    let filtered = match filter {
         Some(f) => {
-            let e = data.evaluate(&args.out, &args.split, Some(f), args.max_samples, &device)?;
-            Some((*f, e))
+            let e = data.evaluate(&args.out, &args.split, Some(&f), args.max_samples, &device)?;
+            Some((f, e))
         }
         None => None,
     };

@@ -21,8 +21,12 @@ pub fn write_png(
     meshes: &[(&TriMesh, [u8; 3])],
     size: (u32, u32),
 ) -> anyhow::Result<()> {
+    save_png(path, &render_views(meshes, size)?)
+}
+
+/// Saves `image` as a PNG at `path` (creating its folder) and says so.
+pub fn save_png(path: &Path, image: &render::Image) -> anyhow::Result<()> {
     create_parent(path)?;
-    let image = render_views(meshes, size)?;
     image
         .save_png(path)
         .with_context(|| format!("writing {}", path.display()))?;
@@ -59,7 +63,6 @@ pub fn write_strain_png(
     vertex_strain: &[f32],
     size: (u32, u32),
 ) -> anyhow::Result<()> {
-    create_parent(path)?;
     let colors = render::palette::heat_colors(vertex_strain, 0.0, STRAIN_MAP_MAX_PCT / 100.0);
     let scene = [
         RenderMesh::new(&body.vertices, &body.faces, render::palette::SKIN),
@@ -72,11 +75,7 @@ pub fn write_strain_png(
         &format!("{STRAIN_MAP_MAX_PCT:.0}%"),
     );
     image.blit(&legend, 16, 16);
-    image
-        .save_png(path)
-        .with_context(|| format!("writing {}", path.display()))?;
-    eprintln!("wrote {}", path.display());
-    Ok(())
+    save_png(path, &image)
 }
 
 /// Creates the parent directory of `path` if it is missing.

@@ -180,6 +180,19 @@ fn train_resume_eval_and_drape() {
     ] {
         assert!(card.contains(needle), "{needle} missing:\n{card}");
     }
+    // A bad filter is refused before anything is written.
+    let bad_out = tmp.path().join("bad.garnet");
+    let err = fails(&[
+        "export",
+        "--model",
+        s(&best),
+        "--data",
+        s(data),
+        "--out",
+        s(&bad_out),
+        "--max-slide=-1",
+    ]);
+    assert!(err.contains("--max-slide") && !bad_out.exists(), "{err}");
     let refused = export(&tmp.path().join("model.bin"));
     assert!(!refused.status.success());
     let err = String::from_utf8_lossy(&refused.stderr);
