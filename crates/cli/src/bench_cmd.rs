@@ -6,6 +6,8 @@ use std::time::{Duration, Instant};
 use body::{BodyModel, Phenotype, Pose, Skinning};
 use clap::Subcommand;
 
+use crate::model_device::DeviceArg;
+
 /// What to benchmark.
 #[derive(Subcommand, Debug)]
 pub enum BenchCmd {
@@ -40,6 +42,9 @@ pub enum BenchCmd {
         /// Edge length of the reference T-shirt, metres (0.01: ~8k vertices).
         #[arg(long, default_value_t = 0.01)]
         edge: f32,
+        /// Where the networks run.
+        #[arg(long, value_enum, default_value_t = DeviceArg::Cpu)]
+        device: DeviceArg,
     },
 }
 
@@ -52,7 +57,8 @@ pub fn run(cmd: &BenchCmd) -> anyhow::Result<()> {
             sizes,
             simulator,
             edge,
-        } => crate::bench_model::bench_model(*runs, sizes, *simulator, *edge),
+            device,
+        } => crate::bench_model::bench_model(*runs, sizes, *simulator, *edge, *device),
     }
 }
 

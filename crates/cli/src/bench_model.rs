@@ -9,20 +9,33 @@ use model::bench::{bench_forward, bench_train_step, Timing};
 use model::{Draper, GarNetConfig, ModelSetup, Variant};
 
 use crate::bench_cmd::TshirtCase;
+use crate::model_device::DeviceArg;
 
 /// Body vertices the networks see (the body model's mesh).
 const BODY_VERTICES: usize = 13380;
 
 /// Runs the benchmark and prints a Markdown table; the reference is the DQS warp of a T-shirt
 /// with `edge` metres; with `simulator`, also the GarNet-Local and simulator times of the same
-/// drape of that T-shirt.
-pub fn bench_model(runs: usize, sizes: &[usize], simulator: bool, edge: f32) -> anyhow::Result<()> {
+/// drape of that T-shirt. The networks run on `device` (the DQS warp and the simulator always
+/// on the CPU).
+pub fn bench_model(
+    runs: usize,
+    sizes: &[usize],
+    simulator: bool,
+    edge: f32,
+    device: DeviceArg,
+) -> anyhow::Result<()> {
+    let backend = match device {
+        DeviceArg::Cpu => "flex CPU backend",
+        DeviceArg::Cuda => "cuda GPU backend",
+        DeviceArg::Vulkan => "vulkan GPU backend",
+    };
+    let device = device.device()?;
     let body_model = BodyModel::load()?;
     let reference = TshirtCase::new(&body_model, edge, 5)?;
     let warp_ms = reference.warp.as_secs_f64() * 1e3;
-    let device = Device::flex();
     println!(
-        "garnet bench model: flex CPU backend, {} threads; body {BODY_VERTICES} vertices; \
+        "garnet bench model: {backend}, {} CPU threads; body {BODY_VERTICES} vertices; \
          reference: DQS warp of the {}-vertex T-shirt",
         rayon::current_num_threads(),
         reference.template.mesh.vertices.len()

@@ -370,6 +370,13 @@ fn bench_model_reports_every_variant_against_the_dqs_warp() {
     assert!(out.contains("faster than the simulator"), "{out}");
 }
 
+/// A GPU backend this build lacks is refused before any work, naming the cargo feature.
+#[test]
+fn bench_model_on_a_backend_not_built_in_says_how_to_build_it() {
+    let err = fails(&["bench", "model", "--device", "vulkan", "--runs", "1"]);
+    assert!(err.contains("--features vulkan"), "{err}");
+}
+
 /// The main job (no command, run from any folder): the three shipped models drape a random
 /// body in a random pose; meshes and a picture land in `out/` of the working directory.
 #[test]
