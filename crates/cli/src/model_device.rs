@@ -47,9 +47,13 @@ impl DeviceArg {
 #[cfg(any(feature = "cuda", feature = "vulkan"))]
 fn probe(device: Device, backend: &str) -> anyhow::Result<Device> {
     let d = device.clone();
+    // The runtime's own panic message would only repeat the error below.
+    let hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
     let answered = std::panic::catch_unwind(move || {
         burn::tensor::Tensor::<1>::from_floats([1.0f32], &d).into_data()
     });
+    std::panic::set_hook(hook);
     match answered {
         Ok(_) => Ok(device),
         Err(_) => anyhow::bail!(
