@@ -25,11 +25,7 @@ pub fn bench_model(
     edge: f32,
     device: DeviceArg,
 ) -> anyhow::Result<()> {
-    let backend = match device {
-        DeviceArg::Cpu => "flex CPU backend",
-        DeviceArg::Cuda => "cuda GPU backend",
-        DeviceArg::Vulkan => "vulkan GPU backend",
-    };
+    let backend = device.backend_name();
     let device = device.device()?;
     let body_model = BodyModel::load()?;
     let reference = TshirtCase::new(&body_model, edge, 5)?;

@@ -57,13 +57,12 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
     save_checkpoint(&args.out, &network, None, &ck.setup, &ck.loss, &ck.state)?;
     let data = EvalData::open(&args.data)?;
     let eval = data.evaluate(&args.out, &args.split, None, args.max_samples, &device)?;
-    let filtered = match filter {
-        Some(f) => {
-            let e = data.evaluate(&args.out, &args.split, Some(&f), args.max_samples, &device)?;
-            Some((f, e))
-        }
-        None => None,
-    };
+    let filtered = filter
+        .map(|f| {
+            data.evaluate(&args.out, &args.split, Some(&f), args.max_samples, &device)
+                .map(|e| (f, e))
+        })
+        .transpose()?;
     let card = model_card(
         &args.model,
         &args.out,

@@ -18,6 +18,15 @@ pub enum DeviceArg {
 }
 
 impl DeviceArg {
+    /// The burn backend this device runs on, in words ("flex CPU backend").
+    pub fn backend_name(self) -> &'static str {
+        match self {
+            DeviceArg::Cpu => "flex CPU backend",
+            DeviceArg::Cuda => "cuda GPU backend",
+            DeviceArg::Vulkan => "vulkan GPU backend",
+        }
+    }
+
     /// The burn device; an error when this build does not include the backend.
     pub fn device(self) -> anyhow::Result<Device> {
         match self {
