@@ -125,6 +125,29 @@ impl Phenotype {
         Ok(())
     }
 
+    /// The phenotype of `values`, in [`Phenotype::named_values`] order (11 values);
+    /// errors if there are not 11 or they fail [`Phenotype::validate`].
+    pub fn from_values(values: &[f32]) -> Result<Self, BodyError> {
+        let v: [f32; 11] = values.try_into().map_err(|_| {
+            BodyError::Parameter(format!("a phenotype has 11 values, got {}", values.len()))
+        })?;
+        let p = Self {
+            gender: v[0],
+            age: v[1],
+            muscle: v[2],
+            weight: v[3],
+            height: v[4],
+            proportions: v[5],
+            cupsize: v[6],
+            firmness: v[7],
+            african: v[8],
+            asian: v[9],
+            caucasian: v[10],
+        };
+        p.validate()?;
+        Ok(p)
+    }
+
     /// `(name, value)` of every parameter.
     pub fn named_values(&self) -> [(&'static str, f32); 11] {
         [
@@ -203,6 +226,23 @@ mod tests {
             let s: f32 = interpolation_weights(v, AGE.anchors).iter().sum();
             assert!((s - 1.0).abs() < 1e-6);
         }
+    }
+
+    #[test]
+    fn from_values_inverts_named_values() {
+        let p = Phenotype {
+            gender: 0.9,
+            weight: 0.2,
+            asian: 0.7,
+            ..Default::default()
+        };
+        let values: Vec<f32> = p.named_values().map(|(_, v)| v).to_vec();
+        assert_eq!(Phenotype::from_values(&values).unwrap(), p);
+        let e = Phenotype::from_values(&values[..10]).unwrap_err();
+        assert!(e.to_string().contains("11 values, got 10"), "{e}");
+        let mut bad = values.clone();
+        bad[3] = f32::NAN;
+        assert!(Phenotype::from_values(&bad).is_err());
     }
 
     #[test]

@@ -62,9 +62,15 @@ pub struct GenerateArgs {
     /// Samples drawn in parallel (default: one per core).
     #[arg(long)]
     pub jobs: Option<usize>,
-    /// Make only shards s with s % n == i (for job arrays; merge the folders after).
-    #[arg(long, value_name = "i/n")]
+    /// Make only shards s with s % n == i (for job arrays), or only the listed shards and
+    /// inclusive ranges, e.g. 0-9,12; merge the folders after.
+    #[arg(long, value_name = "i/n|a-b,c")]
     pub shard: Option<String>,
+    /// Take the samples an earlier dataset of a smaller spec already made (same seed,
+    /// garments, poses and simulator; only the body count, splits, shard size and
+    /// output.compact may differ) instead of simulating them again.
+    #[arg(long, value_name = "DIR")]
+    pub reuse: Option<PathBuf>,
     /// Stop after making this many samples (resume later by running again).
     #[arg(long, value_name = "N")]
     pub max_samples: Option<u64>,
@@ -178,6 +184,7 @@ fn generate(args: &GenerateArgs) -> anyhow::Result<()> {
         opts.selection = ShardSelection::parse(s)?;
     }
     opts.max_new_samples = args.max_samples;
+    opts.reuse.clone_from(&args.reuse);
     let bar = ProgressBar::new(0);
     bar.set_style(
         ProgressStyle::with_template(
@@ -210,9 +217,10 @@ fn generate(args: &GenerateArgs) -> anyhow::Result<()> {
         .with_context(|| format!("generating {}", args.out.display()))?;
     bar.finish_and_clear();
     eprintln!(
-        "{} of {} selected samples were already made; made {} now ({} failed) in {:.1} s; {} shards written{}",
+        "{} of {} selected samples were already made ({} taken from --reuse now); made {} now ({} failed) in {:.1} s; {} shards written{}",
         report.resumed,
         report.selected_samples,
+        report.reused,
         report.made,
         report.failed,
         report.wall_s,

@@ -261,3 +261,52 @@ fn generate_resume_merge_info_show() {
     ]);
     assert!(err.contains("--shard"), "{err}");
 }
+
+#[test]
+fn generate_a_grown_compact_spec_reusing_a_smaller_dataset() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (small_spec, grown_spec) = (d.join("small.toml"), d.join("grown.toml"));
+    std::fs::write(&small_spec, FAST).unwrap();
+    let grown = FAST
+        .replace("count = 2\n[[garments]]", "count = 3\n[[garments]]")
+        .replace("train = 1\ntest = 1", "train = 2\ntest = 1")
+        + "[output]\ncompact = true\n";
+    std::fs::write(&grown_spec, grown).unwrap();
+    let (small, big) = (d.join("small"), d.join("big"));
+    ok(&["dataset", "generate", s(&small_spec), "--out", s(&small)]);
+    // Shards 0 and 3-4: the first two T-shirt samples, then the jeans (9 samples in all).
+    let out = ok(&[
+        "dataset",
+        "generate",
+        s(&grown_spec),
+        "--out",
+        s(&big),
+        "--reuse",
+        s(&small),
+        "--shard",
+        "0,3-4",
+    ]);
+    assert!(
+        out.contains("4 of 5 selected samples were already made (4 taken from --reuse now)"),
+        "{out}"
+    );
+    // The compact dataset's body and M are rebuilt for the picture.
+    let png = d.join("show.png");
+    ok(&["dataset", "show", s(&big), "--index", "0", "--png", s(&png)]);
+    let image = render::Image::from_png(&png).unwrap();
+    assert!(image.count_not(image.pixel(0, 0)) > 20_000);
+    // A dataset of another seed is refused as a source.
+    let other_spec = d.join("other.toml");
+    std::fs::write(&other_spec, FAST.replace("seed = 9", "seed = 10")).unwrap();
+    let err = fails(&[
+        "dataset",
+        "generate",
+        s(&other_spec),
+        "--out",
+        s(&d.join("other")),
+        "--reuse",
+        s(&small),
+    ]);
+    assert!(err.contains("--reuse") && err.contains("seed"), "{err}");
+}

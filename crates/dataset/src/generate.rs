@@ -19,6 +19,7 @@ use crate::layout::{self, body_faces_path, shard_file, spec_path, template_file}
 use crate::manifest::{FileEntry, Manifest};
 use crate::plan::Plan;
 use crate::poses::PoseLibrary;
+use crate::reuse::Reuse;
 use crate::sample::Maker;
 use crate::selection::ShardSelection;
 use crate::shard::{self, ShardInfo};
@@ -46,6 +47,9 @@ pub struct GenerateOptions<'a> {
     pub selection: ShardSelection,
     /// The folder clip paths are relative to.
     pub mocap_root: PathBuf,
+    /// A dataset of a smaller spec whose samples are taken instead of made again (see
+    /// [`crate::reuse`]).
+    pub reuse: Option<PathBuf>,
     /// Stop after making this many samples (the run can be resumed later).
     pub max_new_samples: Option<u64>,
     /// Set to stop: samples in flight finish and are saved, no new one starts.
@@ -61,6 +65,7 @@ impl GenerateOptions<'_> {
             jobs: std::thread::available_parallelism().map_or(1, |n| n.get()),
             selection: ShardSelection::ALL,
             mocap_root,
+            reuse: None,
             max_new_samples: None,
             cancel: None,
             progress: None,
@@ -77,6 +82,8 @@ pub struct GenerateReport {
     pub selected_samples: u64,
     /// Of those, made by earlier runs (in shards or parts).
     pub resumed: u64,
+    /// Of `resumed`, taken from the `--reuse` dataset by this run.
+    pub reused: u64,
     /// Samples made by this run.
     pub made: u64,
     /// Of those, failed.
@@ -137,11 +144,23 @@ pub fn generate(
     }
     reconcile(out, &plan, &mut manifest, &spec.hash)?;
     manifest.save(out)?;
-    let run = crate::run::Run::prepare(out, &plan, &spec.hash, manifest, opts.selection)?;
+    let reuse = match &opts.reuse {
+        Some(dir) => Some(Reuse::open(dir, spec, &library)?),
+        None => None,
+    };
+    let run = crate::run::Run::prepare(
+        out,
+        &plan,
+        &spec.hash,
+        manifest,
+        &opts.selection,
+        reuse.as_ref(),
+    )?;
     let mut report = GenerateReport {
         total_samples: plan.total(),
         selected_samples: run.progress.total,
         resumed: run.progress.done,
+        reused: run.reused,
         stray_temps_removed,
         ..Default::default()
     };

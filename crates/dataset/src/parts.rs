@@ -54,11 +54,12 @@ pub enum Part {
     Failed(FailedPart),
 }
 
-/// Saves finished sample `record.index` of dataset folder `dir`.
-pub fn write_done(dir: &Path, arrays: &SampleArrays, meta: &PartMeta) -> Result<()> {
+/// Saves finished sample `record.index` of dataset folder `dir` (`compact`: without its
+/// body and M, see [`crate::tensors`]).
+pub fn write_done(dir: &Path, arrays: &SampleArrays, meta: &PartMeta, compact: bool) -> Result<()> {
     let k = meta.record.index;
     let json = serde_json::to_string(meta).expect("part metadata serialises");
-    let bytes = tensors::serialize(&arrays.to_tensors(k), PART_KEY, json)?;
+    let bytes = tensors::serialize(&arrays.to_tensors(k, compact), PART_KEY, json)?;
     geom::io::write_bytes_atomic(part_path(dir, k), &bytes)?;
     Ok(())
 }

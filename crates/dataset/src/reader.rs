@@ -10,7 +10,9 @@ use garment::GarmentTemplate;
 
 use crate::error::{DatasetError, Result};
 use crate::hash::sha256_hex;
+use crate::layout;
 use crate::manifest::{FileEntry, Manifest};
+use crate::rebuild::Rebuilder;
 use crate::records::{DrapeFilter, SampleRecord};
 use crate::tensors::{self, SampleArrays};
 
@@ -32,6 +34,7 @@ pub struct Dataset {
     cache_shards: usize,
     shards: Mutex<VecDeque<(u64, Arc<Vec<u8>>)>>,
     templates: Mutex<HashMap<String, Arc<GarmentTemplate>>>,
+    rebuild: Rebuilder,
 }
 
 /// Reads `dir/rel` and checks its sha256.
@@ -54,8 +57,21 @@ fn read_checked(dir: &Path, entry: &FileEntry) -> Result<Vec<u8>> {
 impl Dataset {
     /// Opens the dataset in `dir`, keeping at most two shards in memory.
     pub fn open(dir: &Path) -> Result<Self> {
+        let manifest = Manifest::load(dir)?;
+        let skinning = manifest
+            .spec
+            .simulator
+            .drape_options()
+            .map_err(|(field, m)| {
+                DatasetError::corrupt(
+                    &layout::manifest_path(dir),
+                    format!("simulator.{field}: {m}"),
+                )
+            })?
+            .skinning;
         Ok(Self {
-            manifest: Manifest::load(dir)?,
+            manifest,
+            rebuild: Rebuilder::new(skinning),
             dir: dir.to_path_buf(),
             cache_shards: 2,
             shards: Mutex::new(VecDeque::new()),
@@ -147,7 +163,8 @@ impl Dataset {
     }
 
     /// Stored sample `k`. A sample that failed, was not made, or does not exist is an
-    /// error saying which; a damaged shard is an error naming its file.
+    /// error saying which; a damaged shard is an error naming its file. A compact
+    /// sample's body and M are rebuilt (see [`crate::rebuild`]).
     pub fn sample(&self, k: u64) -> Result<Sample> {
         let m = &self.manifest;
         let Some(entry) = m.sample(k) else {
@@ -165,9 +182,14 @@ impl Dataset {
         let bytes = self.shard_bytes(entry.shard)?;
         let path = self.dir.join(crate::layout::shard_file(entry.shard));
         let (st, _) = tensors::parse(&bytes, crate::shard::SHARD_KEY, &path)?;
+        let mut arrays = SampleArrays::read(&st, k, &path)?;
+        if arrays.body.is_empty() {
+            let template = self.template(&entry.record.template)?;
+            self.rebuild.fill(&entry.record, &mut arrays, &template)?;
+        }
         Ok(Sample {
             record: entry.record.clone(),
-            arrays: SampleArrays::read(&st, k, &path)?,
+            arrays,
         })
     }
 
@@ -177,15 +199,21 @@ impl Dataset {
         if let Some(t) = cache.get(id) {
             return Ok(t.clone());
         }
+        self.template_bytes(id)?;
+        let file = &self.manifest.templates[id].file;
+        let t = Arc::new(GarmentTemplate::load(&self.dir.join(file))?);
+        cache.insert(id.to_string(), t.clone());
+        Ok(t)
+    }
+
+    /// The bytes of template `id`'s file, checked against the manifest.
+    pub fn template_bytes(&self, id: &str) -> Result<Vec<u8>> {
         let entry = self
             .manifest
             .templates
             .get(id)
             .ok_or_else(|| DatasetError::Invalid(format!("no template '{id}'")))?;
-        read_checked(&self.dir, entry)?;
-        let t = Arc::new(GarmentTemplate::load(&self.dir.join(&entry.file))?);
-        cache.insert(id.to_string(), t.clone());
-        Ok(t)
+        read_checked(&self.dir, entry)
     }
 
     /// The body faces `[F]` (vertex index triples into a sample's `body`).

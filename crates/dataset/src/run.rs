@@ -11,6 +11,7 @@ use crate::generate::{note_shard, GenerateOptions, Progress};
 use crate::manifest::Manifest;
 use crate::parts::{self, FailedPart, Part, PartMeta};
 use crate::plan::Plan;
+use crate::reuse::Reuse;
 use crate::sample::{Maker, Outcome};
 use crate::selection::ShardSelection;
 use crate::shard;
@@ -29,21 +30,26 @@ pub(crate) struct Run<'a> {
     pub(crate) ready: Vec<u64>,
     pub(crate) progress: Progress,
     pub(crate) resumed_failed: u64,
+    /// Samples taken from the `--reuse` dataset.
+    pub(crate) reused: u64,
     done: AtomicU64,
     failed: AtomicU64,
     made: AtomicU64,
 }
 
 impl<'a> Run<'a> {
-    /// Finds what is left to do in the selected shards.
+    /// Finds what is left to do in the selected shards, taking from `reuse` the samples
+    /// it holds.
     pub(crate) fn prepare(
         out: &'a Path,
         plan: &'a Plan,
         hash: &'a str,
         manifest: Manifest,
-        selection: ShardSelection,
+        selection: &ShardSelection,
+        reuse: Option<&Reuse>,
     ) -> Result<Self> {
         let (mut todo, mut remaining, mut ready) = (Vec::new(), HashMap::new(), Vec::new());
+        let mut reused = 0;
         let mut progress = Progress::default();
         for s in (0..plan.shard_count()).filter(|&s| selection.contains(s)) {
             let range = plan.shard_range(s);
@@ -61,7 +67,14 @@ impl<'a> Run<'a> {
                         progress.done += 1;
                         progress.failed += matches!(p, Part::Failed(_)) as u64;
                     }
-                    Ok(None) => missing.push(k),
+                    Ok(None) => match reuse.map(|r| r.take(out, plan, k)).transpose()? {
+                        Some(Some(failed)) => {
+                            reused += 1;
+                            progress.done += 1;
+                            progress.failed += failed as u64;
+                        }
+                        _ => missing.push(k),
+                    },
                     // A damaged part is made again.
                     Err(_) => {
                         parts::remove(out, k..k + 1)?;
@@ -85,6 +98,7 @@ impl<'a> Run<'a> {
             remaining,
             ready,
             resumed_failed: progress.failed,
+            reused,
             done: AtomicU64::new(progress.done),
             failed: AtomicU64::new(progress.failed),
             made: AtomicU64::new(0),
@@ -126,7 +140,7 @@ impl<'a> Run<'a> {
                     record,
                     timing,
                 };
-                parts::write_done(self.out, &arrays, &meta)?;
+                parts::write_done(self.out, &arrays, &meta, maker.spec.output.compact)?;
             }
             Outcome::Failed(failure) => {
                 self.failed.fetch_add(1, Ordering::SeqCst);

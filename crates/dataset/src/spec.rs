@@ -37,6 +37,7 @@
 //!
 //! [output]
 //! fitted = false                  # also store the surface-anchored warp
+//! compact = false                 # store no body and no M: readers rebuild them
 //! ```
 //!
 //! Unknown keys are errors; [`LoadedSpec::load`] validates every field and names the file
@@ -254,6 +255,11 @@ pub struct OutputSpec {
     /// Also store the template warped by surface anchors then DQS (`warp_fitted`).
     #[serde(default)]
     pub fitted: bool,
+    /// Store neither the posed body nor M: both follow from the phenotype, the pose and
+    /// the template, and [`crate::Dataset::sample`] rebuilds them (with the body model).
+    /// A sample then takes about a tenth of the space.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub compact: bool,
 }
 
 /// A spec read from a file: the parsed spec, its source, and its hash.

@@ -12,6 +12,9 @@
 //! | `phenotype` | `[11]` | the body's phenotype values, `body::Phenotype::named_values` order |
 //! | `pose.root` | `[3]` | the pose's root translation, metres |
 //! | `pose.rotations` | `[B,4]` | the pose's bone-local rotations, quaternions x, y, z, w (B = 31) |
+//!
+//! A compact dataset (spec `[output] compact = true`) stores neither `body` nor `warped`:
+//! [`SampleArrays::read`] leaves them empty and [`crate::Dataset::sample`] rebuilds them.
 
 use std::path::Path;
 
@@ -24,9 +27,9 @@ use crate::error::{DatasetError, Result};
 /// The arrays of one sample (see the module table for shapes and units).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SampleArrays {
-    /// `[V]` posed body vertices, metres.
+    /// `[V]` posed body vertices, metres (empty when read from a compact sample).
     pub body: Vec<Vec3>,
-    /// `[N]` M, the warped template, metres.
+    /// `[N]` M, the warped template, metres (empty when read from a compact sample).
     pub warped: Vec<Vec3>,
     /// `[N]` G, the draped garment, metres.
     pub draped: Vec<Vec3>,
@@ -53,12 +56,15 @@ fn vec3s(v: &[Vec3]) -> Vec<u8> {
 }
 
 impl SampleArrays {
-    /// The tensors of sample `k`.
-    pub fn to_tensors(&self, k: u64) -> Vec<RawTensor> {
+    /// The tensors of sample `k`; `compact`: without `body` and `warped`.
+    pub fn to_tensors(&self, k: u64, compact: bool) -> Vec<RawTensor> {
         let n = |name: &str| tensor_name(k, name);
-        let mut t = vec![
-            (n("body"), vec![self.body.len(), 3], vec3s(&self.body)),
-            (n("warped"), vec![self.warped.len(), 3], vec3s(&self.warped)),
+        let mut t = Vec::new();
+        if !compact {
+            t.push((n("body"), vec![self.body.len(), 3], vec3s(&self.body)));
+            t.push((n("warped"), vec![self.warped.len(), 3], vec3s(&self.warped)));
+        }
+        t.extend([
             (n("draped"), vec![self.draped.len(), 3], vec3s(&self.draped)),
             (
                 n("phenotype"),
@@ -75,14 +81,15 @@ impl SampleArrays {
                 vec![self.rotations.len(), 4],
                 to_le(self.rotations.iter().flat_map(|q| q.to_array())),
             ),
-        ];
+        ]);
         if let Some(f) = &self.fitted {
             t.push((n("fitted"), vec![f.len(), 3], vec3s(f)));
         }
         t
     }
 
-    /// Reads sample `k` from `st` (a file at `path`, named in errors).
+    /// Reads sample `k` from `st` (a file at `path`, named in errors). A compact sample's
+    /// `body` and `warped` are left empty.
     pub fn read(st: &SafeTensors<'_>, k: u64, path: &Path) -> Result<Self> {
         let floats = |name: &str, cols: usize, required: bool| -> Result<Option<Vec<f32>>> {
             let full = tensor_name(k, name);
@@ -114,11 +121,17 @@ impl SampleArrays {
         let need = |name: &str, cols: usize| -> Result<Vec<f32>> {
             Ok(floats(name, cols, true)?.expect("required"))
         };
-        let (body, warped, draped) = (
-            points(need("body", 3)?),
-            points(need("warped", 3)?),
-            points(need("draped", 3)?),
-        );
+        let (body, warped) = match (floats("body", 3, false)?, floats("warped", 3, false)?) {
+            (Some(b), Some(w)) => (points(b), points(w)),
+            (None, None) => (Vec::new(), Vec::new()),
+            _ => {
+                return Err(DatasetError::corrupt(
+                    path,
+                    format!("sample {k}: only one of body and warped is stored"),
+                ))
+            }
+        };
+        let draped = points(need("draped", 3)?);
         let root = need("pose.root", 1)?;
         if root.len() != 3 {
             return Err(DatasetError::corrupt(
@@ -138,7 +151,7 @@ impl SampleArrays {
                 .map(Quat::from_slice)
                 .collect(),
         };
-        if out.warped.len() != out.draped.len()
+        if (!out.warped.is_empty() && out.warped.len() != out.draped.len())
             || out
                 .fitted
                 .as_ref()
@@ -198,19 +211,44 @@ mod tests {
             root_translation: Vec3::new(0.1, 0.0, -0.2),
             rotations: vec![Quat::from_rotation_y(0.3); 31],
         };
-        let bytes = serialize(&a.to_tensors(7), "m", "{}".into()).unwrap();
+        let bytes = serialize(&a.to_tensors(7, false), "m", "{}".into()).unwrap();
         let (st, meta) = parse(&bytes, "m", Path::new("x")).unwrap();
         assert_eq!(meta, "{}");
         assert_eq!(SampleArrays::read(&st, 7, Path::new("x")).unwrap(), a);
         let e = SampleArrays::read(&st, 8, Path::new("x")).unwrap_err();
         assert!(
-            e.to_string().contains("missing tensor 0000000008.body"),
+            e.to_string().contains("missing tensor 0000000008.draped"),
             "{e}"
         );
         // Same input, same bytes.
         assert_eq!(
             bytes,
-            serialize(&a.to_tensors(7), "m", "{}".into()).unwrap()
+            serialize(&a.to_tensors(7, false), "m", "{}".into()).unwrap()
         );
+    }
+
+    #[test]
+    fn compact_arrays_leave_body_and_warp_empty() {
+        let a = SampleArrays {
+            body: vec![Vec3::ONE; 4],
+            warped: vec![Vec3::X; 2],
+            draped: vec![Vec3::Y; 2],
+            fitted: None,
+            phenotype: vec![0.5; 11],
+            root_translation: Vec3::ZERO,
+            rotations: vec![Quat::IDENTITY; 31],
+        };
+        let bytes = serialize(&a.to_tensors(3, true), "m", "{}".into()).unwrap();
+        let (st, _) = parse(&bytes, "m", Path::new("x")).unwrap();
+        let back = SampleArrays::read(&st, 3, Path::new("x")).unwrap();
+        assert!(back.body.is_empty() && back.warped.is_empty());
+        assert_eq!(back.draped, a.draped);
+        // Only one of the two stored: a damaged sample, not a compact one.
+        let mut half = a.to_tensors(3, true);
+        half.push(a.to_tensors(3, false).swap_remove(0));
+        let bytes = serialize(&half, "m", "{}".into()).unwrap();
+        let (st, _) = parse(&bytes, "m", Path::new("x")).unwrap();
+        let e = SampleArrays::read(&st, 3, Path::new("x")).unwrap_err();
+        assert!(e.to_string().contains("only one of body and warped"), "{e}");
     }
 }
