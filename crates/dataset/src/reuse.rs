@@ -43,11 +43,19 @@ impl Reuse {
         old.splits = new.splits.clone();
         old.shard_size = new.shard_size;
         old.output.compact = new.output.compact;
-        if old.bodies != new.bodies {
-            return Err(differs("the body distribution"));
+        let fields = [
+            ("the seed", old.seed == new.seed),
+            ("the body distribution", old.bodies == new.bodies),
+            ("the garments", old.garments == new.garments),
+            ("the poses", old.poses == new.poses),
+            ("the simulator settings", old.simulator == new.simulator),
+            ("the stored arrays", old.output == new.output),
+        ];
+        if let Some((what, _)) = fields.iter().find(|(_, same)| !same) {
+            return Err(differs(what));
         }
         if old != *new {
-            return Err(differs("the garments, poses, seed, simulator or output"));
+            return Err(differs("its other settings"));
         }
         for f in &library.files {
             let same = data.manifest().mocap.iter().any(|o| o == f);

@@ -80,7 +80,10 @@ fn reuse_refuses_a_dataset_of_another_seed_and_takes_nothing_outside_the_selecti
     let e = dataset::generate(common::model(), &common::spec(&other), dir.path(), &o)
         .unwrap_err()
         .to_string();
-    assert!(e.contains("--reuse") && e.contains("differs"), "{e}");
+    assert!(
+        e.contains("--reuse") && e.contains("differs") && e.contains("in the seed"),
+        "{e}"
+    );
     // Shards 1-2 of the grown dataset: samples 4-11, the T-shirts of bodies 2-4 and the
     // jeans of bodies 0-1; bodies 0-2 come from the reference.
     o.selection = ShardSelection::parse("1-2").unwrap();
