@@ -76,6 +76,10 @@ pub struct ClothSim {
     pub(crate) last_force: Vec<f64>,
     /// `[N]` body velocity at the contact during the last step (zero when not in contact).
     pub(crate) body_vel: Vec<Vec3>,
+    /// `[N]` the body face closest to each vertex at the start of the last step
+    /// ([`crate::collide::NO_FACE`] when none was within its search): hints that make the
+    /// next step's closest-point searches cheaper without changing their results.
+    pub(crate) near_face: Vec<u32>,
 }
 
 impl ClothSim {
@@ -118,6 +122,7 @@ impl ClothSim {
             steps_taken: 0,
             last_force: vec![0.0; n],
             body_vel: vec![Vec3::ZERO; n],
+            near_face: vec![crate::collide::NO_FACE; n],
         };
         sim.build_system()?;
         Ok(sim)

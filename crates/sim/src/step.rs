@@ -25,7 +25,7 @@ use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 use crate::cloth::{ClothSim, StepInfo, MAX_SPEED};
-use crate::collide::{BodyCollider, SurfaceHit};
+use crate::collide::{BodyCollider, SurfaceHit, NO_FACE};
 use crate::error::{Result, SimError};
 use crate::pd::{Contact, PdProblem, MIN_PAR};
 
@@ -64,10 +64,13 @@ impl ClothSim {
         // 1. Contacts at the start of the step.
         let (thick, reach) = self.thickness_and_reach(collider.as_deref());
         let mut contacts: Vec<Option<Contact>> = vec![None; n];
-        // Lower bound of each vertex's distance to the body at the start (metres).
-        let mut dist0 = vec![f32::INFINITY; n];
+        let mut near = vec![Near::FAR; n];
         if let Some(c) = collider.as_deref() {
-            find_contacts(self, c, reach, &mut contacts, &mut dist0);
+            find_contacts(self, c, reach, &mut contacts, &mut near);
+            self.near_face
+                .iter_mut()
+                .zip(&near)
+                .for_each(|(f, n)| *f = n.face);
         }
         info.contacts = contacts.iter().filter(|c| c.is_some()).count();
 
@@ -161,7 +164,7 @@ impl ClothSim {
             } else {
                 Check::Near
             };
-            let fixes = project_out(self, c, &x1, &dist0, reach, thick * PROJECT_FRACTION, check);
+            let fixes = project_out(self, c, &x1, &near, reach, thick * PROJECT_FRACTION, check);
             info.projected = fixes.len();
             for Fix {
                 i,
@@ -251,13 +254,16 @@ impl ClothSim {
     /// [`ClothSim::project_out_of`], applying only the walks out with `walks_only`.
     fn exact_pass(&mut self, collider: &BodyCollider, walks_only: bool) -> (usize, usize) {
         let (thick, reach) = self.thickness_and_reach(Some(collider));
-        let dist0 = vec![0.0; self.x.len()];
+        // Unknown distances (0): every vertex is looked at.
+        let near: Vec<Near> = (self.near_face.iter())
+            .map(|&face| Near { dist: 0.0, face })
+            .collect();
         let x = self.x.clone();
         let mut fixes = project_out(
             self,
             collider,
             &x,
-            &dist0,
+            &near,
             reach,
             thick * PROJECT_FRACTION,
             Check::Exact,
@@ -273,33 +279,55 @@ impl ClothSim {
     }
 }
 
+/// What the start of a step knows of a vertex's distance to the body.
+#[derive(Clone, Copy, Debug)]
+struct Near {
+    /// A lower bound of the distance, metres.
+    dist: f32,
+    /// The closest face when it was within the search ([`NO_FACE`] otherwise): a hint for
+    /// the searches from the vertex's next places.
+    face: u32,
+}
+
+impl Near {
+    /// Nothing known: far away.
+    const FAR: Near = Near {
+        dist: f32::INFINITY,
+        face: NO_FACE,
+    };
+}
+
 /// Fills `contacts` (`[N]`) for the free vertices of `sim` within `reach` of the body at the
-/// start of the step, and `dist0` (`[N]`) with a lower bound of every free vertex's distance
-/// to the body then (searched up to about twice the distance it can travel this step).
+/// start of the step, and `near` (`[N]`) with every free vertex's closest face and a lower
+/// bound of its distance to the body then (searched up to about twice the distance it can
+/// travel this step).
 fn find_contacts(
     sim: &ClothSim,
     c: &BodyCollider,
     reach: f32,
     contacts: &mut [Option<Contact>],
-    dist0: &mut [f32],
+    near: &mut [Near],
 ) {
     let p = &sim.params;
     let max_disp = c.max_displacement();
     let (x, v, pinned) = (&sim.x, &sim.v, &sim.pinned);
     contacts
         .par_iter_mut()
-        .zip(dist0.par_iter_mut())
+        .zip(near.par_iter_mut())
         .enumerate()
         .with_min_len(MIN_PAR)
-        .for_each(|(i, (ct, d0))| {
+        .for_each(|(i, (ct, nr))| {
             if pinned[i] {
                 return;
             }
             let travel = v[i].length() * p.dt + p.gravity.length() * p.dt * p.dt;
             let r = reach + 2.0 * (travel + max_disp);
-            match c.closest_prev(x[i], r) {
+            match c.closest_prev(x[i], r, sim.near_face[i]) {
                 Some(hit) => {
-                    *d0 = hit.distance;
+                    *nr = Near {
+                        dist: hit.distance,
+                        face: hit.face,
+                    };
                     if hit.distance <= reach {
                         let (pt, nrm) = c.plane_cur(hit.face, hit.bary);
                         let carry = c.displacement(hit.face, hit.bary);
@@ -311,7 +339,7 @@ fn find_contacts(
                         });
                     }
                 }
-                None => *d0 = r,
+                None => nr.dist = r,
             }
         });
 }
@@ -343,13 +371,14 @@ struct Fix {
 
 /// The free vertices of `x1` (`[N]`) inside the body or closer to it than `to` (metres) at the
 /// end of the step, each with where it goes (`to` outside the surface) and the outward
-/// direction, found as thoroughly as `check` says (`dist0`: `[N]` lower bounds of the
+/// direction, found as thoroughly as `check` says (`near`: `[N]` what the start of the step
+/// knew: lower bounds of the
 /// distances at the start of the step).
 fn project_out(
     sim: &ClothSim,
     c: &BodyCollider,
     x1: &[Vec3],
-    dist0: &[f32],
+    near: &[Near],
     reach: f32,
     to: f32,
     check: Check,
@@ -370,7 +399,7 @@ fn project_out(
                 return None;
             }
             let xi = x1[i];
-            let verdict = proj.vertex(xi, x0[i], dist0[i]);
+            let verdict = proj.vertex(xi, x0[i], near[i]);
             let fix = match verdict {
                 Verdict::Move(target, out) => Some((target, out)),
                 Verdict::Clear | Verdict::Outside => None,
@@ -425,9 +454,10 @@ struct Projection<'a> {
 }
 
 impl Projection<'_> {
-    /// Where a vertex at `xi` that started the step at `x0`, at least `dist0` metres from
-    /// the body, goes and the outward direction, or why it stays.
-    fn vertex(&self, xi: Vec3, x0: Vec3, dist0: f32) -> Verdict {
+    /// Where a vertex at `xi` that started the step at `x0`, at least `near.dist` metres
+    /// from the body, goes and the outward direction, or why it stays.
+    fn vertex(&self, xi: Vec3, x0: Vec3, near: Near) -> Verdict {
+        let dist0 = near.dist;
         let (c, reach, full) = (self.c, self.reach, self.full);
         let travel = (xi - x0).length() + self.max_disp;
         // Far from the body at the start and not moved enough to reach it: no query
@@ -435,7 +465,7 @@ impl Projection<'_> {
         if !full && dist0 - travel > reach {
             return Verdict::Clear;
         }
-        let hit = match c.surface_within(xi, reach) {
+        let hit = match c.surface_within(xi, reach, near.face) {
             Some(hit) => hit,
             None => {
                 if !full && travel < dist0 {
@@ -478,12 +508,12 @@ const MAX_PROJECTIONS: usize = 4;
 /// `(target, outward direction of the last projection)`.
 fn clear_of_overlaps(c: &BodyCollider, hit: SurfaceHit, reach: f32, to: f32) -> (Vec3, Vec3) {
     let mut target = hit.point + hit.out * to;
-    let mut out = hit.out;
+    let (mut out, mut face) = (hit.out, hit.face);
     for _ in 1..MAX_PROJECTIONS {
-        match c.surface_within(target, reach) {
+        match c.surface_within(target, reach, face) {
             Some(h) if h.signed < 0.0 && c.contains_cur(target) => {
                 target = h.point + h.out * to;
-                out = h.out;
+                (out, face) = (h.out, h.face);
             }
             _ => break,
         }
