@@ -80,6 +80,10 @@ pub struct ClothSim {
     /// ([`crate::collide::NO_FACE`] when none was within its search): hints that make the
     /// next step's closest-point searches cheaper without changing their results.
     pub(crate) near_face: Vec<u32>,
+    /// `[N]` closest body points the last step's projection found (or none).
+    pub(crate) known: Vec<Option<crate::step::KnownHit>>,
+    /// `[N]` lower bounds of the vertices' distances to the body (or none).
+    pub(crate) far: Vec<Option<crate::step::FarBound>>,
 }
 
 impl ClothSim {
@@ -123,6 +127,8 @@ impl ClothSim {
             last_force: vec![0.0; n],
             body_vel: vec![Vec3::ZERO; n],
             near_face: vec![crate::collide::NO_FACE; n],
+            known: Vec::new(),
+            far: Vec::new(),
         };
         sim.build_system()?;
         Ok(sim)

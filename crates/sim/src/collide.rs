@@ -12,6 +12,8 @@
 //! of the closest feature (face, edge or vertex; Baerentzen & Aanaes 2005), which is exact for
 //! closed meshes; far points use the BVH's ray-voting winding test.
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
 use geom::adjacency::{EdgeTopology, NO_EDGE};
 use geom::{Bvh, ClosestHit, TriMesh};
 use glam::Vec3;
@@ -21,6 +23,14 @@ use crate::error::{check_finite, Result, SimError};
 
 /// No face: a search hint for "none known".
 pub(crate) const NO_FACE: u32 = u32::MAX;
+
+/// The next body state's number (shared by every collider, so no two states ever share
+/// one).
+static NEXT_STATE: AtomicU64 = AtomicU64::new(0);
+
+fn new_state() -> u64 {
+    NEXT_STATE.fetch_add(1, Ordering::Relaxed)
+}
 
 /// Directions [`BodyCollider::exit_point`] tries.
 const EXIT_DIRECTIONS: usize = 32;
@@ -48,6 +58,9 @@ pub struct BodyCollider {
     vertex_normals: Vec<Vec3>,
     /// Largest vertex displacement from `prev` to `cur`, metres.
     max_disp: f32,
+    /// Numbers of the body states at `prev` and `cur`: equal numbers, equal bodies.
+    prev_state: u64,
+    cur_state: u64,
 }
 
 /// A cloth point's relation to the body at `cur`.
@@ -57,12 +70,26 @@ pub(crate) struct SurfaceHit {
     pub face: u32,
     /// Closest point on the body.
     pub point: Vec3,
+    /// Barycentric weights of `point` in `face`.
+    pub bary: [f32; 3],
     /// Signed distance (negative inside), metres.
     pub signed: f32,
     /// Unit direction from the surface toward outside at the query point: along
     /// `query - point` (flipped when inside), or the pseudo-normal when the point is on the
     /// surface.
     pub out: Vec3,
+}
+
+impl SurfaceHit {
+    /// The closest point as the BVH search gave it.
+    pub(crate) fn closest(&self) -> ClosestHit {
+        ClosestHit {
+            face: self.face,
+            point: self.point,
+            bary: self.bary,
+            distance: self.signed.abs(),
+        }
+    }
 }
 
 impl BodyCollider {
@@ -114,7 +141,11 @@ impl BodyCollider {
             vertex_pseudo: Vec::new(),
             vertex_normals: Vec::new(),
             max_disp: 0.0,
+            prev_state: 0,
+            cur_state: 0,
         };
+        c.prev_state = new_state();
+        c.cur_state = c.prev_state;
         c.update_normals();
         Ok(c)
     }
@@ -139,6 +170,7 @@ impl BodyCollider {
         check_finite("body vertices", vertices)?;
         self.bvh_cur.refit(vertices)?;
         self.cur.copy_from_slice(vertices);
+        self.cur_state = new_state();
         self.max_disp = self
             .prev
             .iter()
@@ -192,7 +224,20 @@ impl BodyCollider {
             // Same length and finite: refit cannot fail.
             let _ = self.bvh_prev.refit(&self.cur);
         }
+        self.prev_state = self.cur_state;
         self.max_disp = 0.0;
+    }
+
+    /// The number of the body state at the start of the next step: a closest point found at
+    /// the end of a step with [`BodyCollider::cur_state`] `s` holds at the start of the next
+    /// while this is `s`.
+    pub(crate) fn prev_state(&self) -> u64 {
+        self.prev_state
+    }
+
+    /// The number of the body state at the end of the next step.
+    pub(crate) fn cur_state(&self) -> u64 {
+        self.cur_state
     }
 
     /// Closest point at the start of the step within `r` metres of `p`; `hint`: a face
@@ -296,6 +341,7 @@ impl BodyCollider {
         SurfaceHit {
             face: h.face,
             point: h.point,
+            bary: h.bary,
             signed: if inside { -h.distance } else { h.distance },
             out,
         }

@@ -25,7 +25,7 @@ use crate::solver::SpdSolver;
 pub(crate) const MIN_PAR: usize = 256;
 
 /// A body contact of one free vertex for the current step.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Contact {
     /// Body displacement over the step at the contact point, metres.
     pub carry: DVec3,
