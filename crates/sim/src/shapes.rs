@@ -1,11 +1,23 @@
 //! Procedural test scenes: surfaces of revolution about the Y axis (a closed capsule body and
-//! an open "tube shirt" hanging on it). Used by the tests and the timing test of this crate;
+//! an open "tube shirt" hanging on it), and a flat cloth over a sphere. Used by the tests
+//! and the timing test of this crate;
 //! handy for benchmarks that must not depend on body or garment assets.
 
 use std::f32::consts::{FRAC_PI_2, TAU};
 
 use geom::TriMesh;
 use glam::Vec3;
+
+/// The "cloth dropped on a sphere" scene: `(cloth, sphere)`, a sphere of `radius` metres
+/// at the origin (icosphere, 3 subdivisions) and a flat 25 x 25 vertex cloth of 2.5 cm
+/// squares, level, centred over it, `gap` metres above its top.
+pub fn cloth_over_sphere(radius: f32, gap: f32) -> (TriMesh, TriMesh) {
+    let mut cloth = TriMesh::grid(25, 25, 0.025);
+    for v in &mut cloth.vertices {
+        v.y = radius + gap;
+    }
+    (cloth, TriMesh::icosphere(3, radius))
+}
 
 /// Revolves a profile about the Y axis through `center`.
 ///

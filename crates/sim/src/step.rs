@@ -674,11 +674,7 @@ mod tests {
     #[test]
     fn remembered_hits_and_bounds_give_what_the_search_gives() {
         let radius = 0.2;
-        let sphere = TriMesh::icosphere(3, radius);
-        let mut cloth = TriMesh::grid(25, 25, 0.025);
-        for v in &mut cloth.vertices {
-            v.y = radius + 0.03;
-        }
+        let (cloth, sphere) = crate::shapes::cloth_over_sphere(radius, 0.03);
         let params = ClothParams::default();
         let mut sim = ClothSim::new(&cloth, &params).unwrap();
         let mut body = BodyCollider::new(&sphere, params.thickness).unwrap();

@@ -79,11 +79,7 @@ fn hanging_cloth_sags_to_a_catenary_and_stops() {
 #[test]
 fn cloth_dropped_on_a_sphere_rests_outside_it() {
     let radius = 0.2;
-    let sphere = TriMesh::icosphere(3, radius);
-    let mut cloth = TriMesh::grid(25, 25, 0.025);
-    for v in &mut cloth.vertices {
-        v.y = radius + 0.03;
-    }
+    let (cloth, sphere) = sim::shapes::cloth_over_sphere(radius, 0.03);
     let params = ClothParams::default();
     let mut sim = ClothSim::new(&cloth, &params).unwrap();
     let mut body = BodyCollider::new(&sphere, params.thickness).unwrap();
