@@ -310,8 +310,10 @@ impl ClothSim {
 }
 
 /// A vertex's closest body point found at the end of a step, which the next step's
-/// contacts reuse instead of searching again (half the closest-point searches of cloth
-/// resting on a body).
+/// contacts reuse instead of searching again (19% of the contact searches of
+/// `garnet bench sim`'s drape; most of the rest are spared by [`FarBound`]s). Like the
+/// search hints, these caches never change a result, so a failed step may leave them
+/// updated.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct KnownHit {
     /// Where the vertex was.
