@@ -128,7 +128,7 @@ impl ClothSim {
             body_vel: vec![Vec3::ZERO; n],
             near_face: vec![crate::collide::NO_FACE; n],
             known: Vec::new(),
-            far: Vec::new(),
+            far: vec![None; n],
         };
         sim.build_system()?;
         Ok(sim)

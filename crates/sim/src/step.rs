@@ -68,7 +68,6 @@ impl ClothSim {
         let mut near = vec![Near::FAR; n];
         if let Some(c) = collider.as_deref() {
             let mut far = std::mem::take(&mut self.far);
-            far.resize(n, None);
             find_contacts(
                 self,
                 c,
@@ -659,7 +658,6 @@ mod tests {
         let n = sim.x.len();
         let (_, reach) = sim.thickness_and_reach(Some(body));
         let mut far = sim.far.clone();
-        far.resize(n, None);
         let run = |sim: &ClothSim, far: &mut [Option<FarBound>], far_search| {
             let mut contacts = vec![None; n];
             let mut near = vec![Near::FAR; n];
