@@ -141,7 +141,7 @@ fn model_card(
          - progress: {ep} epochs, {st} steps, last learning rate {lr:.1e}; best validation E_dist \
          {best}\n\
          - loss: L_vertex + {pen} L_pen + {norm} L_norm + {bend} L_bend, lengths in {unit}, \
-         d_tol {dtol} m\n{clip}{history}\n",
+         d_tol {dtol} m\n{clip}{mirror}{history}\n",
         ds = manifest.spec.name,
         dir = data.dataset().dir().display(),
         cmd = state
@@ -166,6 +166,11 @@ fn model_card(
         clip = state.max_grad_norm.map_or(String::new(), |n| format!(
             "- gradients clipped to a joint L2 norm of {n} (the last run's setting)\n"
         )),
+        mirror = if state.mirror {
+            "- every other training sample mirrored left-right (the last run's setting)\n"
+        } else {
+            ""
+        },
         history = source
             .parent()
             .map(|d| d.join(model::trainer::METRICS_LOG))

@@ -44,6 +44,11 @@ pub struct TrainArgs {
     /// `train_grad_norm` column shows the norms before clipping.
     #[arg(long, value_name = "NORM")]
     pub grad_clip: Option<f32>,
+    /// Mirror every other training sample left-right through the garment's plane of
+    /// symmetry (a reflected drape is another valid drape: twice the drapes seen per
+    /// epoch); kept by a resumed run.
+    #[arg(long)]
+    pub mirror: bool,
     /// Anneal the learning rate along half a cosine from --lr (at the epoch this run starts
     /// from) to this rate at --epochs; resuming with the same command continues the schedule.
     #[arg(long, value_name = "LR")]
@@ -223,6 +228,19 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
     };
     if args.grad_clip.is_some() {
         trainer.set_max_grad_norm(args.grad_clip)?;
+    }
+    if args.mirror {
+        trainer
+            .set_mirror(true)
+            .with_context(|| format!("--mirror with the '{}' template", args.garment))?;
+    }
+    if let Some(m) = trainer.mirror_map() {
+        eprintln!(
+            "mirroring every other training sample through x = {:.4} m (template reflections \
+             within {:.2} mm of its surface)",
+            m.plane_x(),
+            m.max_offset() * 1e3
+        );
     }
     let schedule = args
         .cosine_to

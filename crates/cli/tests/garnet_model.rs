@@ -71,9 +71,13 @@ fn train_resume_eval_and_drape() {
             &["--batch", "2"],
         ))
     };
-    let log = ok(&as_str(&args("2")));
+    let mut first = args("2");
+    first.push("--mirror".into());
+    let log = ok(&as_str(&first));
     assert!(
-        log.contains("epoch 2") && log.contains("val E_dist"),
+        log.contains("epoch 2")
+            && log.contains("val E_dist")
+            && log.contains("mirroring every other training sample"),
         "{log}"
     );
     let metrics = local.join("metrics.csv");
@@ -86,7 +90,11 @@ fn train_resume_eval_and_drape() {
     let mut resume = args("3");
     resume.push("--resume".into());
     let log = ok(&as_str(&resume));
-    assert!(log.contains("resuming"), "{log}");
+    // The resumed run keeps mirroring without being told again.
+    assert!(
+        log.contains("resuming") && log.contains("mirroring every other training sample"),
+        "{log}"
+    );
     assert_eq!(rows(&metrics), 4);
 
     // Naive with clipped gradients and a cosine schedule over two epochs.
@@ -170,6 +178,7 @@ fn train_resume_eval_and_drape() {
         "| GarNet-local |",
         "| DQS warp (the input M) |",
         "best validation E_dist",
+        "every other training sample mirrored left-right",
         "learning rate by epoch (from the run's metrics.csv): 1.0e-3 (epochs 1-3)",
         // The drapes it was trained on (the filter given to export), and its metrics on them.
         "trained on the 2 of them that are drapes with strain p99 at most 1000%",

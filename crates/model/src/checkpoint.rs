@@ -149,6 +149,9 @@ pub struct TrainState {
     /// Learning-rate schedule (`None`: the rate stays as set).
     #[serde(default)]
     pub schedule: Option<CosineSchedule>,
+    /// Whether every other training sample is mirrored left-right (see [`crate::mirror`]).
+    #[serde(default)]
+    pub mirror: bool,
 }
 
 /// A checkpoint read from disk; [`Checkpoint::model`] and [`Checkpoint::optimizer`] rebuild

@@ -17,6 +17,7 @@ use crate::error::{ModelError, Result};
 use crate::garnet::GarNet;
 use crate::loss::{LossConfig, LossTerms};
 use crate::metrics_log::{MetricsLog, MetricsRow};
+use crate::mirror::MirrorMap;
 use crate::schedule::CosineSchedule;
 use crate::topology::{GarmentTopology, TopologyTensors};
 use crate::train::{adam, evaluate_batch, train_step, StepReport};
@@ -75,6 +76,8 @@ pub struct Trainer {
     loss: LossConfig,
     lr: f64,
     state: TrainState,
+    /// The template's mirror map, while training mirrors samples.
+    mirror: Option<MirrorMap>,
     device: Device,
 }
 
@@ -141,7 +144,7 @@ impl Trainer {
         let topo_valid = topology.to_device(&device.clone().inner());
         setup.validate()?;
         let spec = setup.input_spec();
-        Ok(Trainer {
+        let mut trainer = Trainer {
             model,
             optim,
             setup,
@@ -152,8 +155,11 @@ impl Trainer {
             loss,
             lr,
             state,
+            mirror: None,
             device,
-        })
+        };
+        trainer.set_mirror(trainer.state.mirror)?;
+        Ok(trainer)
     }
 
     /// The network (on the autodiff device).
@@ -199,6 +205,40 @@ impl Trainer {
         Ok(())
     }
 
+    /// Mirrors every other training sample left-right from the next step on (`true`), or
+    /// none (`false`); stored in the checkpoints, so a resumed run keeps it. Mirrored
+    /// samples double the drapes the network sees (see [`crate::mirror`]). Fails when the
+    /// template is not left-right symmetric.
+    pub fn set_mirror(&mut self, on: bool) -> Result<()> {
+        self.mirror = if on {
+            let t = &self.setup.template;
+            Some(MirrorMap::new(&t.vertices, &t.faces)?)
+        } else {
+            None
+        };
+        self.state.mirror = on;
+        Ok(())
+    }
+
+    /// The template's mirror map while training mirrors samples.
+    pub fn mirror_map(&self) -> Option<&MirrorMap> {
+        self.mirror.as_ref()
+    }
+
+    /// The samples the next step trains on: `samples` themselves, or with mirroring on, the
+    /// mirror image of those at an odd position counted from the step number (each epoch
+    /// shuffles, so each drape is seen mirrored in about half the epochs).
+    pub fn augment(&self, samples: &[Sample]) -> Result<Vec<Sample>> {
+        samples
+            .iter()
+            .enumerate()
+            .map(|(j, s)| match &self.mirror {
+                Some(m) if (self.state.step + j as u64) % 2 == 1 => m.mirror_sample(s, &self.spec),
+                _ => Ok(s.clone()),
+            })
+            .collect()
+    }
+
     /// Follows `schedule` from the next epoch of [`Trainer::fit`] on (`None`: the rate stays
     /// as set). Keeps a stored schedule with the same plan (see
     /// [`CosineSchedule::same_plan`]), so resuming with the same command continues it.
@@ -229,10 +269,10 @@ impl Trainer {
         )
     }
 
-    /// One optimiser step on `samples` (which need targets); returns the loss terms and
-    /// the gradient norm.
+    /// One optimiser step on `samples` (which need targets; mirrored as
+    /// [`Trainer::augment`] says); returns the loss terms and the gradient norm.
     pub fn step(&mut self, samples: &[Sample]) -> Result<StepReport> {
-        let batch = self.train_batch(samples)?;
+        let batch = self.train_batch(&self.augment(samples)?)?;
         let report = train_step(
             &mut self.model,
             &mut self.optim,

@@ -458,3 +458,60 @@ fn tiny_model_overfits_one_sample_below_one_millimetre() {
     );
     assert!(e < 1e-3, "E_dist {e} m after {steps} steps");
 }
+
+/// With mirroring on, every other sample of the steps (counted from the step number) is
+/// replaced by its mirror image, and a resumed trainer keeps mirroring.
+#[test]
+fn mirroring_alternates_samples_and_survives_resume() {
+    let device = Device::flex();
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = setup(Variant::Global, 60);
+    // Turn the tube so its open seam faces -z: then it is left-right symmetric.
+    let first_row = s.template.vertices.iter().filter(|p| p.y == 0.7).count();
+    let turn = std::f32::consts::FRAC_PI_2 + std::f32::consts::PI / first_row as f32;
+    let rotation = glam::Quat::from_rotation_y(-turn);
+    for p in &mut s.template.vertices {
+        *p = rotation * *p;
+    }
+    let data = samples(&s, 2);
+    let mut trainer = Trainer::new(s.clone(), LossConfig::new(), 1e-3, &device).unwrap();
+    assert!(trainer.mirror_map().is_none());
+    assert_eq!(bits_of(&trainer.augment(&data).unwrap()), bits_of(&data));
+    trainer.set_mirror(true).unwrap();
+    let map = trainer.mirror_map().unwrap().clone();
+    assert!(map.max_offset() < 1e-5, "{}", map.max_offset());
+    let spec = s.input_spec();
+    let mirrored: Vec<Sample> = data
+        .iter()
+        .map(|d| map.mirror_sample(d, &spec).unwrap())
+        .collect();
+    assert_ne!(bits_of(&mirrored), bits_of(&data));
+    // Step 0: the second sample is mirrored; step 1: the first.
+    let expect = |a: &Sample, b: &Sample| bits_of(&[a.clone(), b.clone()]);
+    assert_eq!(
+        bits_of(&trainer.augment(&data).unwrap()),
+        expect(&data[0], &mirrored[1])
+    );
+    trainer.step(&data[..1]).unwrap();
+    assert_eq!(
+        bits_of(&trainer.augment(&data).unwrap()),
+        expect(&mirrored[0], &data[1])
+    );
+    let path = dir.path().join("last.garnet");
+    trainer.save(&path).unwrap();
+    let resumed = Trainer::resume(&path, None, &device).unwrap();
+    assert!(resumed.state().mirror && resumed.mirror_map() == Some(&map));
+    assert_eq!(
+        bits_of(&resumed.augment(&data).unwrap()),
+        expect(&mirrored[0], &data[1])
+    );
+}
+
+/// The coordinates of every sample's body, M and G as bits.
+fn bits_of(samples: &[Sample]) -> Vec<u32> {
+    let lists: Vec<Vec<Vec3>> = samples
+        .iter()
+        .flat_map(|s| [s.body.clone(), s.warped.clone(), s.target.clone().unwrap()])
+        .collect();
+    bits(&lists)
+}
