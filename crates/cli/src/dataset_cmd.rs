@@ -67,8 +67,8 @@ pub struct GenerateArgs {
     #[arg(long, value_name = "i/n|a-b,c")]
     pub shard: Option<String>,
     /// Take the samples an earlier dataset of a smaller spec already made (same seed,
-    /// garments, poses and simulator; only the body count, splits, shard size and
-    /// output.compact may differ) instead of simulating them again.
+    /// garments, poses and simulator; only the body count, poses per body, splits, shard
+    /// size and output.compact may differ) instead of simulating them again.
     #[arg(long, value_name = "DIR")]
     pub reuse: Option<PathBuf>,
     /// Stop after making this many samples (resume later by running again).

@@ -62,7 +62,7 @@ fn plan_describes_specs_and_names_bad_fields() {
         eprintln!("skipped the repository specs: ../shared/mocap not present");
         return;
     };
-    for name in ["tiny", "standard", "tshirt-large", "paper"] {
+    for name in ["tiny", "standard", "standard-x3", "tshirt-large", "paper"] {
         let spec = repo().join(format!("specs/{name}.toml"));
         let out = ok(&["dataset", "plan", s(&spec), "--mocap", s(&mocap)]);
         assert!(out.contains("samples in"), "{out}");

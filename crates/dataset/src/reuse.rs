@@ -1,8 +1,9 @@
 //! `generate --reuse DIR`: taking the samples that a dataset of a smaller spec already
 //! made. A sample depends on the seed, the garment, the body index, its slot and the pose
-//! pool, not on the number of bodies, the splits, the shard size or the storage, so a spec
-//! that only adds bodies shares the first bodies' samples with the smaller one; they are
-//! copied instead of simulated again.
+//! pool, not on the number of bodies, the poses per body, the splits, the shard size or the
+//! storage, so a spec that only adds bodies or poses shares the smaller one's samples; they
+//! are copied instead of simulated again. (A body's poses are drawn by a partial shuffle,
+//! so its first k of n poses are the k poses a spec of k per body draws.)
 
 use std::path::Path;
 
@@ -25,15 +26,15 @@ pub struct Reuse {
 
 impl Reuse {
     /// Opens the dataset in `dir` for the generation of `spec` (whose clips are `library`).
-    /// Errors unless the two specs differ only in name, body count, splits, shard size and
-    /// `output.compact`, and the clips are the same files.
+    /// Errors unless the two specs differ only in name, body count, poses per body, splits,
+    /// shard size and `output.compact`, and the clips are the same files.
     pub fn open(dir: &Path, spec: &LoadedSpec, library: &PoseLibrary) -> Result<Self> {
         let data = Dataset::open(dir)?;
         let new = &spec.spec;
         let mut old = data.manifest().spec.clone();
         let differs = |what: &str| {
             DatasetError::Invalid(format!(
-                "--reuse {}: its spec differs from {} in {what}; only the name, the body count, the splits, the shard size and output.compact may differ",
+                "--reuse {}: its spec differs from {} in {what}; only the name, the body count, the poses per body, the splits, the shard size and output.compact may differ",
                 dir.display(),
                 spec.path.display()
             ))
@@ -43,6 +44,12 @@ impl Reuse {
         old.splits = new.splits.clone();
         old.shard_size = new.shard_size;
         old.output.compact = new.output.compact;
+        let old_poses: Vec<u32> = old.garments.iter().map(|g| g.poses_per_body).collect();
+        if old.garments.len() == new.garments.len() {
+            for (o, n) in old.garments.iter_mut().zip(&new.garments) {
+                o.poses_per_body = n.poses_per_body;
+            }
+        }
         let fields = [
             ("the seed", old.seed == new.seed),
             ("the body distribution", old.bodies == new.bodies),
@@ -65,6 +72,9 @@ impl Reuse {
         }
         old.bodies.count = data.manifest().spec.bodies.count;
         old.splits = data.manifest().spec.splits.clone();
+        for (g, ppb) in old.garments.iter_mut().zip(old_poses) {
+            g.poses_per_body = ppb;
+        }
         let old_spec = LoadedSpec {
             hash: crate::spec::spec_hash(&old),
             spec: old,
@@ -87,8 +97,12 @@ impl Reuse {
         if desc.body >= self.plan.bodies {
             return Ok(None);
         }
-        let ppb = plan.garments[desc.garment].poses_per_body as u64;
-        let old_k = self.plan.offsets[desc.garment] + desc.body as u64 * ppb + desc.slot as u64;
+        let old_ppb = self.plan.garments[desc.garment].poses_per_body;
+        if desc.slot >= old_ppb {
+            return Ok(None);
+        }
+        let old_k =
+            self.plan.offsets[desc.garment] + desc.body as u64 * old_ppb as u64 + desc.slot as u64;
         let old = self.plan.sample(old_k);
         if self.plan.pool.pose_id(old.pose) != plan.pool.pose_id(desc.pose) {
             return Ok(None);

@@ -91,3 +91,52 @@ fn reuse_refuses_a_dataset_of_another_seed_and_takes_nothing_outside_the_selecti
     assert!(r.finished && !r.complete, "{r:?}");
     assert_eq!((r.selected_samples, r.reused), (8, 4));
 }
+
+#[test]
+fn more_poses_per_body_reuse_the_first_poses_of_each_body() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut o = options(2);
+    o.reuse = Some(reference().to_path_buf());
+    // T-shirt 2 -> 3 poses per body, jeans 1 -> 2, on the same 3 bodies.
+    let more = FAST
+        .replace("poses_per_body = 2", "poses_per_body = 3")
+        .replace("poses_per_body = 1", "poses_per_body = 2");
+    let r = generate(&more, dir.path(), &o);
+    assert!(r.complete && r.reused == 9 && r.made == 6, "{r:?}");
+    let (old, new) = (
+        Dataset::open(reference()).unwrap(),
+        Dataset::open(dir.path()).unwrap(),
+    );
+    // Each body's first poses are the smaller spec's, copied as they were; the new slots
+    // hold poses of their own.
+    for e in &old.manifest().samples {
+        let a = old.sample(e.record.index).unwrap();
+        let twin = new
+            .manifest()
+            .samples
+            .iter()
+            .find(|n| {
+                (n.record.garment.as_str(), n.record.body, n.record.pose.as_str())
+                    == (a.record.garment.as_str(), a.record.body, a.record.pose.as_str())
+            })
+            .expect("reused");
+        let b = new.sample(twin.record.index).unwrap();
+        assert_eq!(a.arrays.draped, b.arrays.draped);
+        assert_eq!(a.record.stats, b.record.stats);
+    }
+    for g in ["tshirt", "jeans"] {
+        for body in 0..3 {
+            let mut poses: Vec<&str> = new
+                .manifest()
+                .samples
+                .iter()
+                .filter(|n| n.record.garment == g && n.record.body == body)
+                .map(|n| n.record.pose.as_str())
+                .collect();
+            let n = poses.len();
+            poses.sort();
+            poses.dedup();
+            assert_eq!(poses.len(), n, "{g} body {body}: distinct poses");
+        }
+    }
+}
