@@ -15,6 +15,18 @@ fn grown() -> String {
         + "[output]\ncompact = true\n"
 }
 
+/// The index of the sample of `data` with `record`'s garment, body and pose.
+fn twin(data: &Dataset, record: &dataset::records::SampleRecord) -> u64 {
+    let key = |r: &dataset::records::SampleRecord| (r.garment.clone(), r.body, r.pose.clone());
+    data.manifest()
+        .samples
+        .iter()
+        .find(|n| key(&n.record) == key(record))
+        .expect("reused")
+        .record
+        .index
+}
+
 #[test]
 fn a_grown_compact_dataset_reuses_the_smaller_one_and_rebuilds_what_it_does_not_store() {
     let dir = tempfile::tempdir().unwrap();
@@ -34,18 +46,7 @@ fn a_grown_compact_dataset_reuses_the_smaller_one_and_rebuilds_what_it_does_not_
     let mut compared = 0;
     for e in &old.manifest().samples {
         let a = old.sample(e.record.index).unwrap();
-        let twin = new.manifest().samples.iter().find(|n| {
-            (
-                n.record.garment.as_str(),
-                n.record.body,
-                n.record.pose.as_str(),
-            ) == (
-                a.record.garment.as_str(),
-                a.record.body,
-                a.record.pose.as_str(),
-            )
-        });
-        let b = new.sample(twin.expect("reused").record.index).unwrap();
+        let b = new.sample(twin(&new, &a.record)).unwrap();
         assert_eq!(a.arrays.draped, b.arrays.draped, "G is copied as it was");
         assert_eq!(a.record.stats, b.record.stats);
         let worst = |x: &[glam::Vec3], y: &[glam::Vec3]| {
@@ -111,16 +112,7 @@ fn more_poses_per_body_reuse_the_first_poses_of_each_body() {
     // hold poses of their own.
     for e in &old.manifest().samples {
         let a = old.sample(e.record.index).unwrap();
-        let twin = new
-            .manifest()
-            .samples
-            .iter()
-            .find(|n| {
-                (n.record.garment.as_str(), n.record.body, n.record.pose.as_str())
-                    == (a.record.garment.as_str(), a.record.body, a.record.pose.as_str())
-            })
-            .expect("reused");
-        let b = new.sample(twin.record.index).unwrap();
+        let b = new.sample(twin(&new, &a.record)).unwrap();
         assert_eq!(a.arrays.draped, b.arrays.draped);
         assert_eq!(a.record.stats, b.record.stats);
     }

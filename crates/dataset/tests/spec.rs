@@ -178,7 +178,12 @@ fn repo_spec(name: &str) -> PathBuf {
 
 #[test]
 fn the_repository_specs_are_valid() {
-    for name in ["tiny.toml", "standard.toml", "standard-x3.toml", "paper.toml"] {
+    for name in [
+        "tiny.toml",
+        "standard.toml",
+        "standard-x3.toml",
+        "paper.toml",
+    ] {
         let spec = LoadedSpec::load(&repo_spec(name)).unwrap_or_else(|e| panic!("{e}"));
         let kinds: Vec<&str> = spec.spec.garments.iter().map(|g| g.kind.as_str()).collect();
         if name != "tiny.toml" {
