@@ -1,7 +1,7 @@
 //! `garnet eval`: trained models on a dataset split, as the paper reports them: Table 1
 //! (E_dist in cm, E_norm in degrees, per garment and variant, DQS as a row, plus the share
 //! of vertices inside the body), Figure 4's precision curves (PNG), and Table 2's timing
-//! (network per drape, DQS warp, simulator). Markdown and JSON.
+//! (network per drape, DQS warp, simulator), with E_dist by motion. Markdown and JSON.
 
 use std::collections::{BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
@@ -21,6 +21,7 @@ use serde::Serialize;
 
 use crate::drape_cmd::checkpoint_template;
 use crate::drape_filter_args::{keep_drapes, DrapeFilterArgs};
+use crate::eval_motion::{ByMotion, MotionRow};
 use crate::model_device::DeviceArg;
 use crate::simulate_cmd::write_json;
 
@@ -174,6 +175,7 @@ pub struct ModelEvaluation {
     net: Row,
     dqs: Row,
     timing: Timing,
+    by_motion: Vec<MotionRow>,
 }
 
 impl ModelEvaluation {
@@ -253,6 +255,7 @@ impl EvalData {
             indices.len()
         );
         let (mut net, mut dqs) = (Errors::default(), Errors::default());
+        let mut by_motion = ByMotion::default();
         let (mut net_ms, mut dqs_ms, mut sim_s) = (Vec::new(), Vec::new(), Vec::new());
         let opts = BatchOptions {
             batch_size: 1,
@@ -277,9 +280,12 @@ impl EvalData {
                 let body = Bvh::from_mesh(&TriMesh::new(a.body.clone(), self.body_faces.clone()))?;
                 net.add(&a.draped, &pred, faces, &body)?;
                 dqs.add(&a.draped, &a.warped, faces, &body)?;
+                let last = |e: &Errors| e.sample_dist.last().copied().unwrap_or(0.0);
+                by_motion.add(&s.record.pose, last(&net), last(&dqs));
             }
         }
         Ok(ModelEvaluation {
+            by_motion: by_motion.rows(&garment, &method),
             net: net.row(&garment, &method),
             dqs: dqs.row(&garment, "DQS"),
             timing: Timing {
@@ -302,6 +308,7 @@ pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
     let data = EvalData::open(&args.data)?;
     let mut rows: Vec<Row> = Vec::new();
     let mut timings: Vec<Timing> = Vec::new();
+    let mut motions: Vec<MotionRow> = Vec::new();
     let mut dqs_done: BTreeSet<String> = BTreeSet::new();
     for path in &args.models {
         let e = data.evaluate(
@@ -316,9 +323,17 @@ pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
             rows.push(e.dqs);
         }
         timings.push(e.timing);
+        motions.extend(e.by_motion);
     }
     let only = filter.map(|f| f.describe());
-    write_reports(&args.out, &args.split, only.as_deref(), &rows, &timings)
+    write_reports(
+        &args.out,
+        &args.split,
+        only.as_deref(),
+        &rows,
+        &timings,
+        &motions,
+    )
 }
 
 /// Writes results.md, results.json and the two precision-curve PNGs into `out`.
@@ -329,6 +344,7 @@ fn write_reports(
     only: Option<&str>,
     rows: &[Row],
     timings: &[Timing],
+    motions: &[MotionRow],
 ) -> anyhow::Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let mut md = format!("# GarNet evaluation (split '{split}')\n\n");
@@ -361,6 +377,7 @@ fn write_reports(
             t.garment, t.method, t.vertices, t.network_ms, t.dqs_ms
         );
     }
+    md += &crate::eval_motion::markdown(motions);
     md += "\nPrecision curves: precision_dist.png (share of vertices within a distance of the \
            simulated drape), precision_norm.png (share of faces within an angle of its normal).\n";
     geom::io::write_bytes_atomic(out.join("results.md"), md.as_bytes())?;
@@ -371,6 +388,7 @@ fn write_reports(
         norm_thresholds_deg: Vec<f32>,
         table1: &'a [Row],
         table2: &'a [Timing],
+        by_motion: &'a [MotionRow],
     }
     write_json(
         &out.join("results.json"),
@@ -380,6 +398,7 @@ fn write_reports(
             norm_thresholds_deg: norm_thresholds(),
             table1: rows,
             table2: timings,
+            by_motion: motions,
         },
     )?;
     let colors = [

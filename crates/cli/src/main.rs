@@ -9,6 +9,7 @@ mod dataset_show;
 mod drape_cmd;
 mod drape_filter_args;
 mod eval_cmd;
+mod eval_motion;
 mod export_cmd;
 mod garment_cmd;
 mod garment_sheet;

@@ -136,6 +136,8 @@ fn train_resume_eval_and_drape() {
         "GarNet-naive",
         "| tshirt | DQS |",
         "simulator / network",
+        "## E_dist by motion",
+        "| tshirt | GarNet-local | procedural walk |",
     ] {
         assert!(report.contains(row), "{row} missing:\n{report}");
     }
