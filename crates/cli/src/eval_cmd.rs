@@ -99,13 +99,14 @@ struct Errors {
 }
 
 impl Errors {
+    /// Adds one drape; returns its mean vertex distance, cm.
     fn add(
         &mut self,
         gt: &[Vec3],
         pred: &[Vec3],
         faces: &[[u32; 3]],
         body: &Bvh,
-    ) -> anyhow::Result<()> {
+    ) -> anyhow::Result<f32> {
         let d: Vec<f32> = vertex_distances(gt, pred)?
             .iter()
             .map(|m| m * 100.0)
@@ -114,15 +115,15 @@ impl Errors {
             .iter()
             .map(|r| r.to_degrees())
             .collect();
-        self.sample_dist
-            .push(d.iter().sum::<f32>() / d.len().max(1) as f32);
+        let mean_dist = d.iter().sum::<f32>() / d.len().max(1) as f32;
+        self.sample_dist.push(mean_dist);
         self.sample_norm
             .push(a.iter().sum::<f32>() / a.len().max(1) as f32);
         self.inside += body.contains_points(pred).iter().filter(|&&i| i).count();
         self.vertices += pred.len();
         self.dists_cm.extend(d);
         self.angles_deg.extend(a);
-        Ok(())
+        Ok(mean_dist)
     }
 
     fn row(&self, garment: &str, method: &str) -> Row {
@@ -278,10 +279,9 @@ impl EvalData {
                 dqs_ms.push(start.elapsed().as_secs_f64() * 1e3);
                 sim_s.extend(self.sim_times.get(&s.record.index));
                 let body = Bvh::from_mesh(&TriMesh::new(a.body.clone(), self.body_faces.clone()))?;
-                net.add(&a.draped, &pred, faces, &body)?;
-                dqs.add(&a.draped, &a.warped, faces, &body)?;
-                let last = |e: &Errors| e.sample_dist.last().copied().unwrap_or(0.0);
-                by_motion.add(&s.record.pose, last(&net), last(&dqs));
+                let net_cm = net.add(&a.draped, &pred, faces, &body)?;
+                let dqs_cm = dqs.add(&a.draped, &a.warped, faces, &body)?;
+                by_motion.add(&s.record.pose, net_cm, dqs_cm);
             }
         }
         Ok(ModelEvaluation {

@@ -29,31 +29,31 @@ pub struct MotionRow {
     dqs_e_dist_cm: f32,
 }
 
-/// Per-drape E_dist (cm) of the network and of DQS, by motion.
+/// Drape count and summed E_dist (cm) of the network and of DQS, by motion.
 #[derive(Default)]
-pub struct ByMotion(BTreeMap<String, (Vec<f32>, Vec<f32>)>);
+pub struct ByMotion(BTreeMap<String, (usize, f64, f64)>);
 
 impl ByMotion {
     /// Records one drape of pose id `pose`: the network's and the DQS warp's mean vertex
     /// distance, cm.
     pub fn add(&mut self, pose: &str, net_cm: f32, dqs_cm: f32) {
-        let (net, dqs) = self.0.entry(motion_of(pose)).or_default();
-        net.push(net_cm);
-        dqs.push(dqs_cm);
+        let (count, net, dqs) = self.0.entry(motion_of(pose)).or_default();
+        *count += 1;
+        *net += net_cm as f64;
+        *dqs += dqs_cm as f64;
     }
 
     /// One row per motion, in name order.
     pub fn rows(&self, garment: &str, method: &str) -> Vec<MotionRow> {
-        let mean = |v: &[f32]| v.iter().sum::<f32>() / v.len().max(1) as f32;
         self.0
             .iter()
-            .map(|(motion, (net, dqs))| MotionRow {
+            .map(|(motion, &(count, net, dqs))| MotionRow {
                 garment: garment.into(),
                 method: method.into(),
                 motion: motion.clone(),
-                samples: net.len(),
-                e_dist_cm: mean(net),
-                dqs_e_dist_cm: mean(dqs),
+                samples: count,
+                e_dist_cm: (net / count as f64) as f32,
+                dqs_e_dist_cm: (dqs / count as f64) as f32,
             })
             .collect()
     }

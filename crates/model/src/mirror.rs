@@ -10,6 +10,7 @@
 //! Inside a face the mesh is linear, so the reflected garment is the simulated surface itself,
 //! sampled at the template's own vertices.
 
+use geom::TriMesh;
 use glam::Vec3;
 
 use crate::batch::{InputSpec, Sample};
@@ -28,36 +29,32 @@ pub struct MirrorMap {
 }
 
 impl MirrorMap {
-    /// The map of the template with rest vertices `rest` `[N]` (metres, canonical frame) and
-    /// faces `faces` `[F]`, mirrored through the plane `x = c` halfway between its extreme
+    /// The map of the template `template` (rest vertices `[N]`, metres, canonical frame, and
+    /// faces `[F]`), mirrored through the plane `x = c` halfway between its extreme
     /// x. Fails when the template is not left-right symmetric: when a vertex's reflection lies
     /// farther from the surface than the mean edge length. Tessellation asymmetry passes (on
     /// the 2.5 cm `standard` templates the reflections lie within 3.3 mm of the surface at
     /// the 99th percentile, 4.8-12.4 mm at most), a garment cut differently on each side does
     /// not.
-    pub fn new(rest: &[Vec3], faces: &[[u32; 3]]) -> Result<MirrorMap> {
+    pub fn new(template: &TriMesh) -> Result<MirrorMap> {
+        let (rest, faces) = (&template.vertices, &template.faces);
         let (lo, hi) = rest
             .iter()
             .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), p| {
                 (lo.min(p.x), hi.max(p.x))
             });
         let plane_x = 0.5 * (lo + hi);
-        let bvh = geom::bvh::Bvh::new(rest, faces)?;
+        let bvh = geom::bvh::Bvh::from_mesh(template)?;
         let mut sources = Vec::with_capacity(rest.len());
         let mut max_offset = 0.0f32;
-        for &p in rest {
+        for &p in rest.iter() {
             let hit = bvh
                 .closest_point(reflect(p, plane_x))
                 .ok_or_else(|| ModelError::InvalidInput("the template has no faces".into()))?;
             max_offset = max_offset.max(hit.distance);
             sources.push((faces[hit.face as usize], hit.bary));
         }
-        let edges = geom::adjacency::edges(faces);
-        let mean_edge = edges
-            .iter()
-            .map(|&[a, b]| rest[a as usize].distance(rest[b as usize]))
-            .sum::<f32>()
-            / edges.len().max(1) as f32;
+        let mean_edge = template.mean_edge_length();
         if max_offset > mean_edge {
             return Err(ModelError::InvalidInput(format!(
                 "the garment template is not left-right symmetric: a vertex's reflection \
@@ -147,7 +144,7 @@ mod tests {
 
     /// A closed, exactly symmetric tube around the Y axis (x in [-r, r]) offset to x = 0.4,
     /// with `ring` vertices per ring: `[N]` vertices and faces.
-    fn tube(ring: usize, offset: f32, twist: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    fn tube(ring: usize, offset: f32, twist: f32) -> TriMesh {
         let mut v = Vec::new();
         for k in 0..4 {
             for i in 0..ring {
@@ -168,18 +165,19 @@ mod tests {
                 f.push([a, d, c]);
             }
         }
-        (v, f)
+        TriMesh::new(v, f)
     }
 
     #[test]
     fn a_symmetric_template_maps_onto_its_own_vertices() {
-        let (rest, faces) = tube(12, 0.4, 0.0);
-        let map = MirrorMap::new(&rest, &faces).unwrap();
+        let template = tube(12, 0.4, 0.0);
+        let rest = &template.vertices;
+        let map = MirrorMap::new(&template).unwrap();
         assert!((map.plane_x() - 0.4).abs() < 1e-6);
         assert!(map.max_offset() < 1e-5);
-        let mirrored = map.mirror_garment(&rest).unwrap();
+        let mirrored = map.mirror_garment(rest).unwrap();
         // The reflected template is the template: each vertex lands on its mirror twin.
-        for (m, r) in mirrored.iter().zip(&rest) {
+        for (m, r) in mirrored.iter().zip(rest) {
             assert!(m.distance(*r) < 1e-5, "{m} vs {r}");
         }
         // Twice mirrored is the original, for any garment shape.
@@ -199,8 +197,9 @@ mod tests {
     fn a_tessellation_asymmetric_template_resamples_its_surface() {
         // Rings turned by 0.3 of a step each: no vertex has a mirror twin, but the surface is
         // symmetric up to its facets' sagitta.
-        let (rest, faces) = tube(24, 0.0, 0.3);
-        let map = MirrorMap::new(&rest, &faces).unwrap();
+        let template = tube(24, 0.0, 0.3);
+        let rest = &template.vertices;
+        let map = MirrorMap::new(&template).unwrap();
         assert!(map.max_offset() < 2e-3, "{}", map.max_offset());
         // A garment that is the template moved rigidly up and sideways: its mirror is the
         // template moved up and the other way, vertex by vertex, up to the facets.
@@ -209,7 +208,7 @@ mod tests {
             .map(|&p| p + Vec3::new(0.05, 0.3, 0.0))
             .collect();
         let mirrored = map.mirror_garment(&moved).unwrap();
-        for (m, r) in mirrored.iter().zip(&rest) {
+        for (m, r) in mirrored.iter().zip(rest) {
             let expected = *r + Vec3::new(-0.05, 0.3, 0.0);
             assert!(m.distance(expected) < 3e-3, "{m} vs {expected}");
         }
@@ -217,19 +216,22 @@ mod tests {
 
     #[test]
     fn a_lopsided_template_is_refused() {
-        let (mut rest, faces) = tube(12, 0.0, 0.0);
+        let mut template = tube(12, 0.0, 0.0);
         // One side cut 40 cm longer than the other.
-        for p in rest.iter_mut().filter(|p| p.x > 0.1) {
+        for p in template.vertices.iter_mut().filter(|p| p.x > 0.1) {
             p.y += 0.4;
         }
-        let err = MirrorMap::new(&rest, &faces).unwrap_err().to_string();
+        let err = MirrorMap::new(&template).unwrap_err().to_string();
         assert!(err.contains("not left-right symmetric"), "{err}");
     }
 
     #[test]
     fn a_mirrored_sample_keeps_normals_outward_and_distances() {
         // The body is the tube; the garment a copy 2 cm out along the normals.
-        let (rest, faces) = tube(16, 0.0, 0.0);
+        let TriMesh {
+            vertices: rest,
+            faces,
+        } = tube(16, 0.0, 0.0);
         let topo = BodyTopology::new(rest.len(), faces.clone()).unwrap();
         let normals = geom::normals::vertex_normals(&rest, &faces);
         let garment: Vec<Vec3> = rest
@@ -244,7 +246,7 @@ mod tests {
             local: None,
             canonical_rest: Some(garment.clone()),
         };
-        let map = MirrorMap::new(&garment, &faces).unwrap();
+        let map = MirrorMap::new(&TriMesh::new(garment.clone(), faces.clone())).unwrap();
         let m = map.mirror_sample(&sample, &spec).unwrap();
         let recomputed = geom::normals::vertex_normals(&m.body, &faces);
         for (n, r) in m.body_normals.iter().zip(&recomputed) {

@@ -211,8 +211,7 @@ impl Trainer {
     /// template is not left-right symmetric.
     pub fn set_mirror(&mut self, on: bool) -> Result<()> {
         self.mirror = if on {
-            let t = &self.setup.template;
-            Some(MirrorMap::new(&t.vertices, &t.faces)?)
+            Some(MirrorMap::new(&self.setup.template)?)
         } else {
             None
         };
@@ -272,7 +271,10 @@ impl Trainer {
     /// One optimiser step on `samples` (which need targets; mirrored as
     /// [`Trainer::augment`] says); returns the loss terms and the gradient norm.
     pub fn step(&mut self, samples: &[Sample]) -> Result<StepReport> {
-        let batch = self.train_batch(&self.augment(samples)?)?;
+        let batch = match self.mirror {
+            Some(_) => self.train_batch(&self.augment(samples)?)?,
+            None => self.train_batch(samples)?,
+        };
         let report = train_step(
             &mut self.model,
             &mut self.optim,
