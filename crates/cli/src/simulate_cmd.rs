@@ -27,9 +27,10 @@ pub struct SimulateArgs {
     pub shape: ShapeArgs,
     #[command(flatten)]
     pub pose: PoseArgs,
-    /// How the body is skinned during the animation.
-    #[arg(long, value_enum, default_value_t = SkinningArg::Dqs)]
-    pub skinning: SkinningArg,
+    /// How the body is skinned during the animation [default: dqs, or the --simulator
+    /// file's].
+    #[arg(long, value_enum)]
+    pub skinning: Option<SkinningArg>,
     /// The draped garment (.obj, .ply, .glb).
     #[arg(long, default_value = "out/draped.obj")]
     pub out: PathBuf,
@@ -52,12 +53,19 @@ pub struct SimulateArgs {
     /// With --frames: keep every Nth step.
     #[arg(long, default_value_t = 5)]
     pub frames_every: u32,
-    /// Most settling steps after the animation.
-    #[arg(long, default_value_t = 400)]
-    pub max_settle_steps: u32,
-    /// A drape leaving a garment vertex deeper than this inside the body fails, mm.
-    #[arg(long, default_value_t = 1.0)]
-    pub max_penetration_mm: f32,
+    /// Simulator settings: a TOML file with the keys of a dataset spec's `[simulator]`
+    /// table (`friction = 0.2`, `stretch_stiffness = 5000.0`, `dt = 0.01`, ...), at its top
+    /// level or under a `[simulator]` header, so a dataset spec drapes as its dataset did.
+    /// Keys it leaves out keep their defaults.
+    #[arg(long, value_name = "FILE.toml")]
+    pub simulator: Option<PathBuf>,
+    /// Most settling steps after the animation [default: 400, or the --simulator file's].
+    #[arg(long)]
+    pub max_settle_steps: Option<u32>,
+    /// A drape leaving a garment vertex deeper than this inside the body fails, mm
+    /// [default: 1, or the --simulator file's].
+    #[arg(long)]
+    pub max_penetration_mm: Option<f32>,
     /// Drape the pose exactly as given: no limb clearance (by default a limb that sinks
     /// into the body, as a heavy arm into the chest, is first turned out of it).
     #[arg(long)]
@@ -76,13 +84,7 @@ pub struct SimulateArgs {
 
 pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let model = BodyModel::load()?;
-    let opts = DrapeOptions {
-        skinning: args.skinning.into(),
-        max_settle_steps: args.max_settle_steps,
-        max_penetration: args.max_penetration_mm * 1e-3,
-        clearance: (!args.keep_pose).then(ClearanceOptions::default),
-        ..DrapeOptions::default()
-    };
+    let opts = drape_options(args)?;
     if let Some(sheet) = &args.sheet {
         return crate::simulate_sheet::write_sheet(&model, sheet, &args.mocap, args.edge, &opts);
     }
@@ -164,6 +166,30 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         )?;
     }
     Ok(())
+}
+
+/// The drape options of `args`: the defaults, then the `--simulator` file's settings, then
+/// the flags.
+fn drape_options(args: &SimulateArgs) -> anyhow::Result<DrapeOptions> {
+    let mut opts = match &args.simulator {
+        Some(path) => dataset::simulator::load_drape_options(path)?,
+        None => DrapeOptions::default(),
+    };
+    if let Some(skinning) = args.skinning {
+        opts.skinning = skinning.into();
+    }
+    opts.clearance = (!args.keep_pose).then(ClearanceOptions::default);
+    if let Some(steps) = args.max_settle_steps {
+        opts.max_settle_steps = steps;
+    }
+    if let Some(mm) = args.max_penetration_mm {
+        anyhow::ensure!(
+            mm.is_finite() && mm >= 0.0,
+            "--max-penetration-mm must be a non-negative number of millimetres, got {mm}"
+        );
+        opts.max_penetration = mm * 1e-3;
+    }
+    Ok(opts)
 }
 
 /// Writes `value` as pretty JSON to `path` (atomically).

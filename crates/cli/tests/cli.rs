@@ -272,6 +272,68 @@ fn garment_commands_refuse_bad_input() {
     assert!(err.contains("bad.garment"), "{err}");
 }
 
+/// `--simulator` reads a spec's `[simulator]` keys (bare or under the header, beside other
+/// tables), the flags override them, and a bad file is refused naming the file and the key.
+#[test]
+fn simulate_takes_simulator_settings_from_a_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    ok(&[
+        "garment",
+        "make",
+        "tshirt",
+        "--edge",
+        "0.04",
+        "--out",
+        s(&p("t.garment")),
+    ]);
+    let settle = |file: &str, text: &str, flags: &[&str]| {
+        let (template, settings) = (p("t.garment"), p(file));
+        let (out, stats) = (p("d.obj"), p("d.json"));
+        std::fs::write(&settings, text).unwrap();
+        let mut args = vec![
+            "simulate",
+            "--template",
+            s(&template),
+            "--simulator",
+            s(&settings),
+            "--out",
+            s(&out),
+            "--stats",
+            s(&stats),
+        ];
+        args.extend_from_slice(flags);
+        ok(&args);
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+        json["settle_steps"].as_u64().unwrap()
+    };
+    // A rest speed no cloth reaches: settling runs out of its step budget.
+    let never = "rest_speed = 1e-9\nmax_settle_steps = 3\n";
+    assert_eq!(settle("bare.toml", never, &[]), 3);
+    let spec = format!("[bodies]\ncount = 3\n\n[simulator]\n{never}");
+    assert_eq!(settle("spec.toml", &spec, &[]), 3);
+    assert_eq!(settle("spec.toml", &spec, &["--max-settle-steps", "5"]), 5);
+    for (text, key) in [
+        ("friction = -1.0\n", "friction"),
+        ("[simulator]\nfrictoin = 0.2\n", "frictoin"),
+        ("friction = \"high\"\n", "line 1"),
+    ] {
+        std::fs::write(p("bad.toml"), text).unwrap();
+        let err = fails(&[
+            "simulate",
+            "--template",
+            s(&p("t.garment")),
+            "--simulator",
+            s(&p("bad.toml")),
+            "--out",
+            s(&p("x.obj")),
+        ]);
+        assert!(err.contains("bad.toml") && err.contains(key), "{err}");
+        assert!(!p("x.obj").exists());
+    }
+}
+
 #[test]
 fn simulate_drapes_a_template_and_reports_statistics() {
     let dir = tempfile::tempdir().unwrap();

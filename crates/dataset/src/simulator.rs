@@ -1,9 +1,21 @@
 //! Turning the spec's `[simulator]` overrides into the simulator's drape options.
 
+use std::path::Path;
+
 use body::Skinning;
 use sim::drape::DrapeOptions;
 
+use crate::error::{DatasetError, Result};
 use crate::spec::SimulatorSpec;
+
+/// The drape options given by the simulator settings file at `path` (see
+/// [`SimulatorSpec::load`]): the defaults with its overrides, checked. Errors name the file
+/// and the key at fault.
+pub fn load_drape_options(path: &Path) -> Result<DrapeOptions> {
+    SimulatorSpec::load(path)?
+        .drape_options()
+        .map_err(|(field, message)| DatasetError::spec(path, field, message))
+}
 
 impl SimulatorSpec {
     /// The drape options: the simulator's defaults with this spec's overrides. Errors are

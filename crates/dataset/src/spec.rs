@@ -298,6 +298,28 @@ impl LoadedSpec {
     }
 }
 
+impl SimulatorSpec {
+    /// Reads simulator settings from the TOML file at `path`: the keys of a spec's
+    /// `[simulator]` table, either under a `[simulator]` header (so a dataset spec itself
+    /// gives its simulator settings) or at the top level of the file. Errors name the file
+    /// and the line or key at fault; an unknown key is one.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| DatasetError::io(path, e))?;
+        let table: toml::Table = toml::from_str(&text).map_err(|e| toml_error(path, &text, e))?;
+        if table.contains_key("simulator") {
+            /// A file with a `[simulator]` table and anything else beside it.
+            #[derive(Deserialize)]
+            struct Wrapped {
+                simulator: SimulatorSpec,
+            }
+            let w: Wrapped = toml::from_str(&text).map_err(|e| toml_error(path, &text, e))?;
+            Ok(w.simulator)
+        } else {
+            toml::from_str(&text).map_err(|e| toml_error(path, &text, e))
+        }
+    }
+}
+
 /// Hex sha256 of the canonical JSON of `spec`.
 pub fn spec_hash(spec: &Spec) -> String {
     let json = serde_json::to_string(spec).expect("a spec serialises");
