@@ -46,6 +46,8 @@ impl SimulatorSpec {
         set(&mut o.explode_speed, self.explode_speed);
         set(&mut o.max_penetration, self.max_penetration);
         o.grade = self.grade.unwrap_or(o.grade);
+        // Datasets skin with DQS unless their spec says otherwise (see the field's doc).
+        o.skinning = Skinning::Dqs;
         if let Some(s) = &self.skinning {
             o.skinning = match s.to_ascii_lowercase().as_str() {
                 "dqs" => Skinning::Dqs,
@@ -118,6 +120,11 @@ mod tests {
         assert_eq!(o.cloth.friction, 0.2);
         assert_eq!(o.skinning, Skinning::Lbs);
         assert_eq!(o.pose_steps, DrapeOptions::default().pose_steps);
+        // A spec without a skinning keeps DQS, whatever the simulator's default: the
+        // datasets made before the default became LBS rebuild their bodies with it.
+        let plain = SimulatorSpec::default().drape_options().unwrap();
+        assert_eq!(plain.skinning, Skinning::Dqs);
+        assert_eq!(DrapeOptions::default().skinning, Skinning::Lbs);
         let bad = SimulatorSpec {
             density: Some(-1.0),
             ..Default::default()

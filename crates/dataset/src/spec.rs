@@ -242,7 +242,9 @@ pub struct SimulatorSpec {
     pub explode_speed: Option<f32>,
     /// Deepest garment vertex allowed inside the body, metres.
     pub max_penetration: Option<f32>,
-    /// Skinning of the body during the animation: `dqs` or `lbs`.
+    /// Skinning of the body during the animation: `dqs` or `lbs`; `dqs` when absent (the
+    /// simulator's default until session 13, kept so that every dataset made before
+    /// means what it meant; its bodies are rebuilt with it).
     pub skinning: Option<String>,
     /// Grade the garment to the target body.
     pub grade: Option<bool>,

@@ -1,7 +1,7 @@
 //! The drape driver on the real body model: the root's yaw is applied exactly, and the
 //! garment ends on the body it was draped on.
 
-use body::{BodyModel, Phenotype, Pose, Skinning};
+use body::{BodyModel, Phenotype, Pose};
 use garment::{build_template, CutParams, GarmentKind};
 use glam::{Quat, Vec3};
 use sim::drape::{drape, DrapeOptions};
@@ -51,7 +51,7 @@ fn a_turned_body_gets_the_same_drape_turned() {
     assert_eq!(frames, (s.animation_steps + s.settle_steps) as usize);
     // Without its yaw the pose is the rest pose: the pose phase is a single step.
     assert!(s.animation_steps <= opts.morph_steps + 1, "{s:?}");
-    let expected_body = target.posed(&pose, Skinning::Dqs).unwrap();
+    let expected_body = target.posed(&pose, opts.skinning).unwrap();
     let body_err = turned
         .body
         .vertices
