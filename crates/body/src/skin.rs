@@ -28,6 +28,25 @@ pub enum Skinning {
     Dqs,
 }
 
+impl Skinning {
+    /// The method's short name: `"lbs"` or `"dqs"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Skinning::Lbs => "lbs",
+            Skinning::Dqs => "dqs",
+        }
+    }
+
+    /// The method named `name` (`lbs` or `dqs`, any case); `None` for any other name.
+    pub fn from_name(name: &str) -> Option<Skinning> {
+        match name.to_ascii_lowercase().as_str() {
+            "lbs" => Some(Skinning::Lbs),
+            "dqs" => Some(Skinning::Dqs),
+            _ => None,
+        }
+    }
+}
+
 impl SkinWeights {
     /// Number of vertices.
     pub fn len(&self) -> usize {
@@ -177,6 +196,15 @@ fn blend_dual<I: Iterator<Item = (usize, f32)>>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn skinning_names_round_trip() {
+        for s in [Skinning::Lbs, Skinning::Dqs] {
+            assert_eq!(Skinning::from_name(s.name()), Some(s));
+        }
+        assert_eq!(Skinning::from_name("LBS"), Some(Skinning::Lbs));
+        assert_eq!(Skinning::from_name("cubic"), None);
+    }
 
     fn two_bone_weights() -> SkinWeights {
         SkinWeights::from_rows(&[vec![(0, 1.0)], vec![(1, 2.0)], vec![(0, 1.0), (1, 1.0)]]).unwrap()

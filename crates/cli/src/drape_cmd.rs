@@ -125,13 +125,18 @@ pub fn run(args: &DrapeArgs) -> anyhow::Result<()> {
     } else {
         clear_limbs(&target, &pose, &ClearanceOptions::default())?.0
     };
-    let body = target.posed(&pose, Skinning::Dqs)?;
+    let drapers = args
+        .models
+        .iter()
+        .map(|path| {
+            Draper::load(path, &device).with_context(|| format!("loading {}", path.display()))
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let body = target.posed(&pose, body_skinning(&args.models, &drapers)?)?;
     let mut scene: Vec<(String, TriMesh, [u8; 3])> = Vec::new();
     let several = args.models.len() > 1;
-    for path in &args.models {
-        let draper =
-            Draper::load(path, &device).with_context(|| format!("loading {}", path.display()))?;
-        let template = checkpoint_template(&draper, path)?;
+    for (path, draper) in args.models.iter().zip(&drapers) {
+        let template = checkpoint_template(draper, path)?;
         let start = Instant::now();
         let m = warp(&template, &target, &pose, Skinning::Dqs)?;
         let warp_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -176,6 +181,26 @@ pub fn run(args: &DrapeArgs) -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// How the body must be posed for the models at `paths` (`drapers`, loaded from them): the
+/// skinning of the bodies they learned from, which they must share.
+fn body_skinning(paths: &[PathBuf], drapers: &[Draper]) -> anyhow::Result<Skinning> {
+    let names: Vec<&str> = drapers
+        .iter()
+        .map(|d| d.setup().body_skinning.as_str())
+        .collect();
+    if let Some(k) = names.iter().position(|n| *n != names[0]) {
+        anyhow::bail!(
+            "{} learned from bodies posed with {}, {} with {}: drape them in separate runs",
+            paths[0].display(),
+            names[0],
+            paths[k].display(),
+            names[k]
+        );
+    }
+    let name = names.first().copied().unwrap_or("dqs");
+    Skinning::from_name(name).with_context(|| format!("unknown body skinning '{name}'"))
 }
 
 /// `path` with `-KIND` added to its file stem (`out/draped.glb` -> `out/draped-tshirt.glb`).

@@ -239,6 +239,7 @@ impl EvalData {
         let data = &self.data;
         let draper =
             Draper::load(path, device).with_context(|| format!("loading {}", path.display()))?;
+        crate::train_cmd::check_body_skinning(draper.setup(), data, path)?;
         let template = checkpoint_template(&draper, path)?;
         let faces = &template.mesh.faces;
         let garment = matching_garment(data, split, &template.mesh)?;

@@ -223,9 +223,11 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
             config.body_subsample = n;
         }
         let setup = ModelSetup::new(config, template.mesh.clone(), &train.reference_body()?)?
-            .with_garment_file(garment_file);
+            .with_garment_file(garment_file)
+            .with_body_skinning(data.body_skinning().name())?;
         Trainer::new(setup, loss_config(args), args.lr, &device)?
     };
+    check_body_skinning(trainer.setup(), &data, &last)?;
     if args.grad_clip.is_some() {
         trainer.set_max_grad_norm(args.grad_clip)?;
     }
@@ -334,6 +336,25 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
 }
 
 /// The paper's loss weights, with the terms `args` turned off set to zero.
+/// Fails, naming `model`, when the network `setup` learned from bodies posed another way than
+/// the dataset `data` poses them: its inputs would not be what it learned from.
+pub fn check_body_skinning(
+    setup: &ModelSetup,
+    data: &Dataset,
+    model: &std::path::Path,
+) -> anyhow::Result<()> {
+    let expected = data.body_skinning().name();
+    if setup.body_skinning != expected {
+        bail!(
+            "{}: the network learned from bodies posed with {}, the dataset in {} poses them              with {expected}",
+            model.display(),
+            setup.body_skinning,
+            data.dir().display()
+        );
+    }
+    Ok(())
+}
+
 fn loss_config(args: &TrainArgs) -> LossConfig {
     let mut cfg = LossConfig::new();
     cfg.units_per_metre = match args.loss_unit {

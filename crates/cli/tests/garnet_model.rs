@@ -8,7 +8,8 @@ use std::sync::OnceLock;
 
 use common::{fails, garnet, ok, s};
 
-/// 3 bodies (train, val, test) x T-shirt in 2 poses: 6 samples of an 8 cm T-shirt.
+/// 3 bodies (train, val, test) x T-shirt in 2 poses: 6 samples of an 8 cm T-shirt, on
+/// bodies skinned by linear blending (the shipped models learned from DQS bodies).
 const SPEC: &str = r#"
 name = "model-cli"
 seed = 4
@@ -32,6 +33,7 @@ pose_steps = 3
 max_settle_steps = 5
 iterations = 2
 max_penetration = 0.5
+skinning = "lbs"
 "#;
 
 /// The dataset folder, generated on first use (kept in a folder that lives as long as the
@@ -322,6 +324,30 @@ fn drape_and_eval_refuse_what_does_not_fit() {
     // A missing model file.
     let err = fails(&["eval", "--data", s(data), "--model", "nope.garnet"]);
     assert!(err.contains("nope.garnet"), "{err}");
+    // Bodies posed another way than the network learned from: a shipped model (DQS bodies)
+    // on this dataset (LBS bodies), or draped in one run with a model trained on it.
+    let shipped = common::repo().join("models/tshirt-naive.garnet");
+    let err = fails(&["eval", "--data", s(data), "--model", s(&shipped)]);
+    assert!(
+        err.contains("tshirt-naive.garnet")
+            && err.contains("posed with dqs")
+            && err.contains("with lbs"),
+        "{err}"
+    );
+    let naive = tmp.path().join("naive");
+    ok(&train_args(data, "naive", "1", &naive, &[]));
+    let trained = naive.join("best.garnet");
+    let err = fails(&[
+        "drape",
+        "--model",
+        s(&trained),
+        "--model",
+        s(&shipped),
+        "--out",
+        s(&tmp.path().join("x.obj")),
+    ]);
+    assert!(err.contains("separate runs"), "{err}");
+    assert!(!tmp.path().join("x-tshirt.obj").exists());
 }
 
 /// `v` as the `&str` arguments [`ok`] takes.

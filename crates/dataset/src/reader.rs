@@ -6,6 +6,7 @@ use std::collections::{HashMap, VecDeque};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
+use body::Skinning;
 use garment::GarmentTemplate;
 
 use crate::error::{DatasetError, Result};
@@ -55,6 +56,12 @@ fn read_checked(dir: &Path, entry: &FileEntry) -> Result<Vec<u8>> {
 }
 
 impl Dataset {
+    /// How the dataset's simulator posed its bodies (and so how a network trained on it
+    /// expects bodies posed).
+    pub fn body_skinning(&self) -> Skinning {
+        self.rebuild.skinning()
+    }
+
     /// Opens the dataset in `dir`, keeping at most two shards in memory.
     pub fn open(dir: &Path) -> Result<Self> {
         let manifest = Manifest::load(dir)?;

@@ -24,6 +24,11 @@ pub struct Rebuilder {
 }
 
 impl Rebuilder {
+    /// The skinning the bodies are posed with.
+    pub fn skinning(&self) -> Skinning {
+        self.skinning
+    }
+
     /// A rebuilder for bodies posed with `skinning`; the body model is loaded (from the
     /// installed assets, [`BodyModel::load`]) on first use.
     pub fn new(skinning: Skinning) -> Self {

@@ -49,16 +49,12 @@ impl SimulatorSpec {
         // Datasets skin with DQS unless their spec says otherwise (see the field's doc).
         o.skinning = Skinning::Dqs;
         if let Some(s) = &self.skinning {
-            o.skinning = match s.to_ascii_lowercase().as_str() {
-                "dqs" => Skinning::Dqs,
-                "lbs" => Skinning::Lbs,
-                _ => {
-                    return Err((
-                        "skinning".into(),
-                        format!("'{s}' is not a skinning method (dqs or lbs)"),
-                    ))
-                }
-            };
+            o.skinning = Skinning::from_name(s).ok_or_else(|| {
+                (
+                    "skinning".to_string(),
+                    format!("'{s}' is not a skinning method (dqs or lbs)"),
+                )
+            })?;
         }
         if let Err(e) = o.cloth.validate() {
             let text = e.to_string();

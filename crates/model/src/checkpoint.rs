@@ -57,7 +57,15 @@ pub struct ModelSetup {
     /// Whether the network works in each sample's canonical frame (see [`crate::frame`]);
     /// true for every new setup, false for checkpoints written before the frame existed.
     pub canonical_frame: bool,
+    /// How the bodies it learned from were posed: [`BODY_SKINNINGS`] names, `"dqs"` (dual
+    /// quaternions) or `"lbs"` (linear blending), the skinning of the dataset's simulator.
+    /// A body given to the network must be posed the same way. `"dqs"` for checkpoints
+    /// written before it was recorded (every dataset was DQS then).
+    pub body_skinning: String,
 }
+
+/// The names [`ModelSetup::body_skinning`] may take.
+pub const BODY_SKINNINGS: [&str; 2] = ["dqs", "lbs"];
 
 impl ModelSetup {
     /// The setup of `config` for the garment `template`, sampling the body points on
@@ -84,7 +92,16 @@ impl ModelSetup {
             body_sampling,
             garment_file: None,
             canonical_frame: true,
+            body_skinning: BODY_SKINNINGS[0].into(),
         })
+    }
+
+    /// This setup for bodies posed with the skinning named `name` (see
+    /// [`ModelSetup::body_skinning`]); fails on a name not in [`BODY_SKINNINGS`].
+    pub fn with_body_skinning(mut self, name: &str) -> Result<Self> {
+        self.body_skinning = name.to_string();
+        self.validate()?;
+        Ok(self)
     }
 
     /// This setup carrying the garment template file `bytes` (see [`ModelSetup::garment_file`]).
@@ -109,6 +126,12 @@ impl ModelSetup {
     /// Fails when the template or the sampling is invalid, or the sampling has fewer kept
     /// points than GarNet-Local's neighbour count.
     pub fn validate(&self) -> Result<()> {
+        if !BODY_SKINNINGS.contains(&self.body_skinning.as_str()) {
+            return Err(ModelError::InvalidInput(format!(
+                "body skinning '{}' is not one of {BODY_SKINNINGS:?}",
+                self.body_skinning
+            )));
+        }
         self.config.validate()?;
         self.template.validate()?;
         self.body_sampling.validate()?;
@@ -259,6 +282,7 @@ pub fn save_checkpoint(
         ("body.n_vertices".into(), s.n_body.to_string()),
         ("body.n_centres".into(), s.n_centres.to_string()),
         ("canonical_frame".into(), setup.canonical_frame.to_string()),
+        ("body.skinning".into(), setup.body_skinning.clone()),
     ]);
     let views = tensors
         .iter()
@@ -368,6 +392,10 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint> {
         body_sampling,
         garment_file,
         canonical_frame: meta.get("canonical_frame").is_some_and(|v| v == "true"),
+        body_skinning: meta
+            .get("body.skinning")
+            .cloned()
+            .unwrap_or_else(|| BODY_SKINNINGS[0].into()),
     };
     setup.validate().map_err(|e| bad(e.to_string()))?;
     Ok(Checkpoint {

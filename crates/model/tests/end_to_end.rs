@@ -204,8 +204,12 @@ fn batch_refuses_mismatched_samples() {
 fn checkpoints_round_trip_exactly_and_resume_training() {
     let device = Device::flex();
     let dir = tempfile::tempdir().unwrap();
-    // The checkpoint also carries an opaque garment file, byte for byte.
-    let s = setup(Variant::Local, 60).with_garment_file((0..=255u8).cycle().take(1000).collect());
+    // The checkpoint also carries an opaque garment file, byte for byte, and the skinning
+    // of the bodies it learned from.
+    let s = setup(Variant::Local, 60)
+        .with_garment_file((0..=255u8).cycle().take(1000).collect())
+        .with_body_skinning("lbs")
+        .unwrap();
     let data = samples(&s, 3);
     let mut trainer = Trainer::new(s.clone(), LossConfig::new(), 1e-3, &device).unwrap();
     for _ in 0..3 {
@@ -224,6 +228,7 @@ fn checkpoints_round_trip_exactly_and_resume_training() {
     assert_eq!(bits(&before), bits(&after));
 
     let ck = load_checkpoint(&path).unwrap();
+    assert_eq!(ck.setup.body_skinning, "lbs");
     assert_eq!(ck.state.step, 3);
     assert!(ck.has_optimizer());
     assert_eq!(ck.loss, LossConfig::new());
@@ -290,6 +295,17 @@ fn corrupt_or_foreign_checkpoints_are_clear_errors() {
     assert!(!ck.has_optimizer());
     ck.setup.config = ck.setup.config.clone().with_conv_width(24);
     assert!(ck.model(&device).is_err());
+    // A skinning the body model does not have; a checkpoint from before the skinning was
+    // recorded (the shipped models) learned from DQS bodies.
+    assert!(setup(Variant::Global, 60)
+        .with_body_skinning("cubic")
+        .is_err());
+    let shipped =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/tshirt-naive.garnet");
+    assert_eq!(
+        load_checkpoint(&shipped).unwrap().setup.body_skinning,
+        "dqs"
+    );
     // A network saved with a setup of another variant.
     let local = setup(Variant::Local, 60);
     assert!(save_checkpoint(
