@@ -335,7 +335,6 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The paper's loss weights, with the terms `args` turned off set to zero.
 /// Fails, naming `model`, when the network `setup` learned from bodies posed another way than
 /// the dataset `data` poses them: its inputs would not be what it learned from.
 pub fn check_body_skinning(
@@ -346,7 +345,8 @@ pub fn check_body_skinning(
     let expected = data.body_skinning().name();
     if setup.body_skinning != expected {
         bail!(
-            "{}: the network learned from bodies posed with {}, the dataset in {} poses them              with {expected}",
+            "{}: the network learned from bodies posed with {}, the dataset in {} poses them \
+             with {expected}",
             model.display(),
             setup.body_skinning,
             data.dir().display()
@@ -355,6 +355,7 @@ pub fn check_body_skinning(
     Ok(())
 }
 
+/// The paper's loss weights, with the terms `args` turned off set to zero.
 fn loss_config(args: &TrainArgs) -> LossConfig {
     let mut cfg = LossConfig::new();
     cfg.units_per_metre = match args.loss_unit {

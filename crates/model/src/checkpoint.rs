@@ -123,8 +123,9 @@ impl ModelSetup {
         }
     }
 
-    /// Fails when the template or the sampling is invalid, or the sampling has fewer kept
-    /// points than GarNet-Local's neighbour count.
+    /// Fails when the body skinning is not one of [`BODY_SKINNINGS`], the template or the
+    /// sampling is invalid, or the sampling has fewer kept points than GarNet-Local's
+    /// neighbour count.
     pub fn validate(&self) -> Result<()> {
         if !BODY_SKINNINGS.contains(&self.body_skinning.as_str()) {
             return Err(ModelError::InvalidInput(format!(
