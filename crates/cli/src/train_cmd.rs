@@ -210,8 +210,10 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
     let last = out.join(model::trainer::LAST_CHECKPOINT);
     let mut trainer = if args.resume && last.is_file() {
         eprintln!("resuming from {}", last.display());
-        Trainer::resume(&last, Some(args.lr), &device)
-            .with_context(|| format!("resuming {}", last.display()))?
+        let trainer = Trainer::resume(&last, Some(args.lr), &device)
+            .with_context(|| format!("resuming {}", last.display()))?;
+        check_body_skinning(trainer.setup(), &data, &last)?;
+        trainer
     } else {
         if args.resume {
             eprintln!("no {} yet: starting afresh", last.display());
@@ -227,7 +229,6 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
             .with_body_skinning(data.body_skinning().name())?;
         Trainer::new(setup, loss_config(args), args.lr, &device)?
     };
-    check_body_skinning(trainer.setup(), &data, &last)?;
     if args.grad_clip.is_some() {
         trainer.set_max_grad_norm(args.grad_clip)?;
     }

@@ -67,6 +67,17 @@ pub struct ModelSetup {
 /// The names [`ModelSetup::body_skinning`] may take.
 pub const BODY_SKINNINGS: [&str; 2] = ["dqs", "lbs"];
 
+/// Fails on a body skinning name not in [`BODY_SKINNINGS`].
+fn known_body_skinning(name: &str) -> Result<()> {
+    if BODY_SKINNINGS.contains(&name) {
+        Ok(())
+    } else {
+        Err(ModelError::InvalidInput(format!(
+            "body skinning '{name}' is not one of {BODY_SKINNINGS:?}"
+        )))
+    }
+}
+
 impl ModelSetup {
     /// The setup of `config` for the garment `template`, sampling the body points on
     /// `reference_body` (`[V]`, metres; any body of the dataset, e.g. the template body).
@@ -99,8 +110,8 @@ impl ModelSetup {
     /// This setup for bodies posed with the skinning named `name` (see
     /// [`ModelSetup::body_skinning`]); fails on a name not in [`BODY_SKINNINGS`].
     pub fn with_body_skinning(mut self, name: &str) -> Result<Self> {
+        known_body_skinning(name)?;
         self.body_skinning = name.to_string();
-        self.validate()?;
         Ok(self)
     }
 
@@ -127,12 +138,7 @@ impl ModelSetup {
     /// sampling is invalid, or the sampling has fewer kept points than GarNet-Local's
     /// neighbour count.
     pub fn validate(&self) -> Result<()> {
-        if !BODY_SKINNINGS.contains(&self.body_skinning.as_str()) {
-            return Err(ModelError::InvalidInput(format!(
-                "body skinning '{}' is not one of {BODY_SKINNINGS:?}",
-                self.body_skinning
-            )));
-        }
+        known_body_skinning(&self.body_skinning)?;
         self.config.validate()?;
         self.template.validate()?;
         self.body_sampling.validate()?;
