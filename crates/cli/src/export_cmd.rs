@@ -11,7 +11,7 @@ use burn::module::Module;
 use clap::Args;
 use model::{load_checkpoint, save_checkpoint, Checkpoint};
 
-use dataset::DrapeFilter;
+use dataset::{Dataset, DrapeFilter};
 
 use crate::drape_filter_args::{filter_flags, DrapeFilterArgs};
 use crate::eval_cmd::{EvalData, ModelEvaluation};
@@ -23,9 +23,15 @@ pub struct ExportArgs {
     /// Training checkpoint (`best.garnet` or `last.garnet` of `garnet train`).
     #[arg(long, value_name = "CKPT")]
     pub model: PathBuf,
-    /// The dataset the model was trained on (its test split gives the card's metrics).
+    /// The dataset whose `--split` gives the card's metrics: the one the model was trained
+    /// on, unless `--train-data` names another.
     #[arg(long, value_name = "DIR")]
     pub data: PathBuf,
+    /// The dataset the model was trained on, when it is not `--data`: a larger dataset of
+    /// the same bodies (as `standard-x3` is of `standard`), so the card can report the
+    /// metrics on `--data`'s test split. Its training bodies must not be in that split.
+    #[arg(long, value_name = "DIR")]
+    pub train_data: Option<PathBuf>,
     /// Split for the card's metrics.
     #[arg(long, default_value = "test")]
     pub split: String,
@@ -49,13 +55,33 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
     let filter = args.drapes.filter()?;
     let ck = load_checkpoint(&args.model)
         .with_context(|| format!("loading {}", args.model.display()))?;
+    let data = EvalData::open(&args.data)?;
+    let train_data = args
+        .train_data
+        .as_deref()
+        .map(|d| Dataset::open(d).with_context(|| format!("--train-data {}", d.display())))
+        .transpose()?;
+    let train = train_data.as_ref().unwrap_or(data.dataset());
+    let seen = train
+        .manifest()
+        .shared_bodies("train", data.dataset().manifest(), &args.split)?;
+    if !seen.is_empty() {
+        bail!(
+            "{}: {} of its training bodies are in the '{}' split of {} (bodies {:?}...): the \
+             card's figures must be on bodies the model never saw",
+            train.dir().display(),
+            seen.len(),
+            args.split,
+            args.data.display(),
+            &seen[..seen.len().min(5)]
+        );
+    }
     let device = DeviceArg::Cpu.device()?;
     let network = ck.model(&device)?;
     if let Some(dir) = args.out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
     save_checkpoint(&args.out, &network, None, &ck.setup, &ck.loss, &ck.state)?;
-    let data = EvalData::open(&args.data)?;
     let eval = data.evaluate(&args.out, &args.split, None, args.max_samples, &device)?;
     let filtered = filter
         .map(|f| {
@@ -68,7 +94,8 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
         &args.out,
         &ck,
         network.num_params(),
-        &data,
+        train,
+        data.dataset(),
         &args.split,
         &eval,
         filtered.as_ref(),
@@ -84,15 +111,17 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The model card (Markdown) of the exported model at `path`; `filtered`: the filter of
-/// the drapes it was trained on and its evaluation on the test drapes that pass it.
+/// The model card (Markdown) of the exported model at `path`, trained on `train` and
+/// evaluated (`eval`) on `data`'s `split`; `filtered`: the filter of the drapes it was
+/// trained on and its evaluation on the test drapes that pass it.
 #[allow(clippy::too_many_arguments)]
 fn model_card(
     source: &Path,
     path: &Path,
     ck: &Checkpoint,
     params: usize,
-    data: &EvalData,
+    train: &Dataset,
+    data: &Dataset,
     split: &str,
     eval: &ModelEvaluation,
     filtered: Option<&(DrapeFilter, ModelEvaluation)>,
@@ -103,12 +132,11 @@ fn model_card(
     let loss = &ck.loss;
     let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("model");
     let size_mb = std::fs::metadata(path)?.len() as f64 / 1e6;
-    let manifest = data.dataset().manifest();
-    let mut train_indices = data.dataset().select(Some("train"), Some(&eval.garment))?;
+    let mut train_indices = train.select(Some("train"), Some(&eval.garment))?;
     let train_all = train_indices.len();
-    let train = match filtered {
+    let trained_on = match filtered {
         Some((f, _)) => {
-            data.dataset().retain_drapes(&mut train_indices, f);
+            train.retain_drapes(&mut train_indices, f);
             format!(
                 "{} training samples of this garment, trained on the {} of them that are {}",
                 train_all,
@@ -142,8 +170,9 @@ fn model_card(
          {best}\n\
          - loss: L_vertex + {pen} L_pen + {norm} L_norm + {bend} L_bend, lengths in {unit}, \
          d_tol {dtol} m\n{clip}{mirror}{history}\n",
-        ds = manifest.spec.name,
-        dir = data.dataset().dir().display(),
+        train = trained_on,
+        ds = train.manifest().spec.name,
+        dir = train.dir().display(),
         cmd = state
             .command
             .as_deref()
@@ -181,9 +210,12 @@ fn model_card(
             )),
     );
     md += &format!(
-        "## Test metrics ('{split}' split: bodies never seen in training)\n\n\
+        "## Test metrics ('{split}' split of '{name}', `{dir}`: bodies never seen in \
+         training)\n\n\
          | method | samples | E_dist (cm) | E_norm (deg) | vertices inside the body |\n\
-         |---|---:|---:|---:|---:|\n"
+         |---|---:|---:|---:|---:|\n",
+        name = data.manifest().spec.name,
+        dir = data.dir().display(),
     );
     let mut rows = vec![
         (format!("GarNet-{}", cfg.variant.name()), net),
@@ -211,9 +243,14 @@ fn model_card(
         ))
     );
     md += &format!(
-        "\nMade by `garnet export --model {} --data {} --out {}{}`.\n",
+        "\nMade by `garnet export --model {} --data {}{} --out {}{}`.\n",
         source.display(),
-        data.dataset().dir().display(),
+        data.dir().display(),
+        if train.dir() == data.dir() {
+            String::new()
+        } else {
+            format!(" --train-data {}", train.dir().display())
+        },
         path.display(),
         filtered.map_or(String::new(), |(f, _)| filter_flags(f))
     );

@@ -209,6 +209,55 @@ fn train_resume_eval_and_drape() {
         err.contains("model.bin") && err.contains(".garnet"),
         "{err}"
     );
+    // Trained on another dataset of the same bodies (as standard-x3 is of standard; here a
+    // folder with this one's manifest, all export reads of it): the card counts that
+    // dataset's training drapes and reports the metrics on --data's test split.
+    let twin_data = tmp.path().join("twin-data");
+    std::fs::create_dir_all(&twin_data).unwrap();
+    let manifest = std::fs::read_to_string(data.join("manifest.json")).unwrap();
+    std::fs::write(twin_data.join("manifest.json"), &manifest).unwrap();
+    let export_twin = |out: &Path, split: &str| {
+        garnet(&[
+            "export",
+            "--model",
+            s(&best),
+            "--data",
+            s(data),
+            "--train-data",
+            s(&twin_data),
+            "--split",
+            split,
+            "--out",
+            s(out),
+        ])
+    };
+    let twin = tmp.path().join("twin.garnet");
+    assert!(export_twin(&twin, "test").status.success());
+    let card = std::fs::read_to_string(twin.with_extension("md")).unwrap();
+    for needle in [
+        format!("(`{}`, spec", twin_data.display()),
+        format!("split of 'model-cli', `{}`", data.display()),
+        format!("--train-data {} --out", twin_data.display()),
+    ] {
+        assert!(card.contains(&needle), "{needle} missing:\n{card}");
+    }
+    // Figures on bodies it trained on, or a dataset of other bodies, are refused before
+    // anything is written.
+    let refused = export_twin(&bad_out, "train");
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        err.contains("training bodies are in the 'train' split"),
+        "{err}"
+    );
+    std::fs::write(
+        twin_data.join("manifest.json"),
+        manifest.replacen("\"seed\": 4,", "\"seed\": 5,", 1),
+    )
+    .unwrap();
+    let refused = export_twin(&bad_out, "test");
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(err.contains("draw their bodies differently"), "{err}");
+    assert!(!bad_out.exists());
 
     // Draping needs only the (exported) model file.
     let out = tmp.path().join("draped.obj");

@@ -3,7 +3,7 @@
 //! body, pose, simulator statistics and wall times), every failed sample with its reason,
 //! and the bodies of each split. It is rewritten (atomically) after every shard.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
@@ -255,5 +255,43 @@ impl Manifest {
             .binary_search_by_key(&k, |e| e.record.index)
             .ok()
             .map(|i| &self.samples[i])
+    }
+
+    /// The bodies of this dataset's split `split` that are also bodies of `other`'s split
+    /// `other_split`, ascending. Body `b`'s shape is drawn from the spec's seed, shape
+    /// distribution and `b`, so two datasets share a body index exactly when they draw
+    /// bodies alike. Errors if a split is unknown, or if the two draw their bodies
+    /// differently (another seed or shape distribution: no body can be matched).
+    pub fn shared_bodies(
+        &self,
+        split: &str,
+        other: &Manifest,
+        other_split: &str,
+    ) -> Result<Vec<u32>> {
+        if self.spec.seed != other.spec.seed
+            || self.spec.bodies.distribution != other.spec.bodies.distribution
+        {
+            return Err(DatasetError::Invalid(format!(
+                "'{}' and '{}' draw their bodies differently (another seed or shape \
+                 distribution), so their bodies cannot be matched",
+                self.spec.name, other.spec.name
+            )));
+        }
+        let bodies = |m: &Manifest, s: &str| -> Result<BTreeSet<u32>> {
+            m.splits
+                .get(s)
+                .map(|b| b.iter().copied().collect())
+                .ok_or_else(|| {
+                    let known: Vec<&str> = m.splits.keys().map(String::as_str).collect();
+                    DatasetError::Invalid(format!(
+                        "'{}' has no split '{s}' (the splits are {})",
+                        m.spec.name,
+                        known.join(", ")
+                    ))
+                })
+        };
+        let mine = bodies(self, split)?;
+        let theirs = bodies(other, other_split)?;
+        Ok(mine.intersection(&theirs).copied().collect())
     }
 }

@@ -5,7 +5,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
-use dataset::{LoadedSpec, Plan};
+use dataset::{LoadedSpec, Manifest, Plan};
 
 const SPEC: &str = r#"
 seed = 17
@@ -145,4 +145,36 @@ fn pool_and_shards_cover_the_samples() {
         .sum();
     assert_eq!(covered, p.total());
     assert!((0..p.total()).all(|k| p.shard_range(p.shard_of(k)).contains(&k)));
+}
+
+#[test]
+fn datasets_drawing_bodies_alike_share_bodies_split_by_split() {
+    let manifest = |text: &str| {
+        let spec = LoadedSpec::parse(text, Path::new("s.toml")).unwrap();
+        Manifest::new(&spec, &Plan::new(&spec, &FRAMES).unwrap(), Vec::new())
+    };
+    let base = manifest(SPEC);
+    // More poses per body (as standard-x3 to standard): the same bodies in the same splits.
+    let more = manifest(&SPEC.replace("poses_per_body = 6", "poses_per_body = 18"));
+    assert!(more
+        .shared_bodies("train", &base, "test")
+        .unwrap()
+        .is_empty());
+    assert_eq!(
+        more.shared_bodies("test", &base, "test").unwrap(),
+        base.splits["test"]
+    );
+    assert_eq!(
+        base.shared_bodies("train", &base, "train").unwrap().len(),
+        48
+    );
+    // Another seed draws other bodies: nothing can be matched.
+    let other = manifest(&SPEC.replace("seed = 17", "seed = 18"));
+    let err = other.shared_bodies("train", &base, "test").unwrap_err();
+    assert!(
+        err.to_string().contains("draw their bodies differently"),
+        "{err}"
+    );
+    let err = base.shared_bodies("train", &base, "holdout").unwrap_err();
+    assert!(err.to_string().contains("no split 'holdout'"), "{err}");
 }
