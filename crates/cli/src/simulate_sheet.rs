@@ -169,29 +169,28 @@ fn short(what: &str) -> String {
 /// A Markdown table of the cases and a summary line.
 fn markdown(cases: &[Case]) -> String {
     let mut out = String::from(
-        "| garment | shape | pose | time (s) | steps | at rest | max pen. (mm) | strain p99 (%) | slid (cm) | limbs turned (deg) | walked out |\n|---|---|---|---:|---:|---|---:|---:|---:|---:|---:|\n",
+        "| garment | shape | pose | time (s) | steps | at rest | max pen. (mm) | strain p99 (%) | skin stretch p90 (%) | slid (cm) | limbs turned (deg) | walked out |\n|---|---|---|---:|---:|---|---:|---:|---:|---:|---:|---:|\n",
     );
     for c in cases {
         match &c.stats {
-            Some(s) => {
-                out += &format!(
-                    "| {} | {} | {} | {:.2} | {} | {} | {:.2} | {:.2} | {:.1} | {:.0} | {} |\n",
-                    c.garment,
-                    c.shape_seed,
-                    c.pose,
-                    s.wall_time_s,
-                    s.animation_steps + s.settle_steps,
-                    if s.converged { "yes" } else { "no" },
-                    s.max_penetration_m * 1e3,
-                    s.strain_p99 * 100.0,
-                    s.slid_m * 100.0,
-                    s.limb_turn_deg,
-                    s.walked_out
-                )
-            }
+            Some(s) => out += &format!(
+                "| {} | {} | {} | {:.2} | {} | {} | {:.2} | {:.2} | {:.1} | {:.1} | {:.0} | {} |\n",
+                c.garment,
+                c.shape_seed,
+                c.pose,
+                s.wall_time_s,
+                s.animation_steps + s.settle_steps,
+                if s.converged { "yes" } else { "no" },
+                s.max_penetration_m * 1e3,
+                s.strain_p99 * 100.0,
+                s.skin_stretch_p90 * 100.0,
+                s.slid_m * 100.0,
+                s.limb_turn_deg,
+                s.walked_out
+            ),
             None => {
                 out += &format!(
-                    "| {} | {} | {} | failed: {} | | | | | | | |\n",
+                    "| {} | {} | {} | failed: {} | | | | | | | | |\n",
                     c.garment,
                     c.shape_seed,
                     c.pose,

@@ -321,22 +321,38 @@ fn simulate_skins_with_linear_blending_so_raised_shoulders_fit_the_armholes() {
         "--pose-kind",
         "yoga",
     ];
-    let strain_p99 = |skinning: &[&str]| {
-        let flags = [&yoga[..], skinning].concat();
-        simulate_stats(&template, &flags)["strain_p99"]
-            .as_f64()
-            .unwrap()
+    // (strain p99, stretch p90 of the skin under the cloth)
+    let stretch = |flags: &[&str]| {
+        let st = simulate_stats(&template, flags);
+        let get = |k: &str| st[k].as_f64().unwrap();
+        (get("strain_p99"), get("skin_stretch_p90"))
     };
+    let with = |skinning: &[&str]| stretch(&[&yoga[..], skinning].concat());
     let (dqs, lbs, default) = (
-        strain_p99(&["--skinning", "dqs"]),
-        strain_p99(&["--skinning", "lbs"]),
-        strain_p99(&[]),
+        with(&["--skinning", "dqs"]),
+        with(&["--skinning", "lbs"]),
+        with(&[]),
     );
     assert!(
-        lbs < 0.75 * dqs,
-        "strain p99 {lbs} with LBS, {dqs} with DQS"
+        lbs.0 < 0.75 * dqs.0,
+        "strain p99 {lbs:?} with LBS, {dqs:?} with DQS"
     );
     assert_eq!(default, lbs);
+    // The skin under the shirt is stretched as much as the shirt is: far more in this pose
+    // than in a walk, which the shirt drapes unstretched.
+    let walk = stretch(&[
+        "--random-shape",
+        "101",
+        "--pose-procedural",
+        "101",
+        "--pose-kind",
+        "walk",
+    ]);
+    assert!(
+        walk.1 < 0.15 && lbs.1 > 2.0 * walk.1 && dqs.1 > lbs.1,
+        "skin stretch p90: walk {walk:?}, yoga LBS {lbs:?}, DQS {dqs:?}"
+    );
+    assert!(walk.0 < lbs.0, "walk {walk:?}, yoga {lbs:?}");
 }
 
 /// `--simulator` reads a spec's `[simulator]` keys (bare or under the header, beside other

@@ -217,6 +217,46 @@ impl BodyCollider {
             .collect()
     }
 
+    /// How far the body's skin under the cloth is stretched: for every body edge of a face
+    /// whose surface lies within `within` metres of one of `points` (`[P]` metres, the
+    /// cloth), its length at the current position over its length in `rest` (`[N]` metres,
+    /// the same body in its rest pose), minus 1; `[E']`, one value per such edge, in no set
+    /// order. Cloth held to the skin by friction must stretch as much, or slide.
+    pub fn skin_stretch_under(
+        &self,
+        rest: &[Vec3],
+        points: &[Vec3],
+        within: f32,
+    ) -> Result<Vec<f32>> {
+        if rest.len() != self.cur.len() {
+            return Err(SimError::InvalidInput(format!(
+                "rest body has {} vertices, the collider's body {}",
+                rest.len(),
+                self.cur.len()
+            )));
+        }
+        check_finite("rest body", rest)?;
+        let touched: Vec<u32> = points
+            .par_iter()
+            .filter_map(|&p| self.bvh_cur.closest_point_within(p, within).map(|h| h.face))
+            .collect();
+        let mut seen = vec![false; self.edge_faces.len()];
+        let mut stretch = Vec::new();
+        for f in touched {
+            let face = self.faces[f as usize];
+            for (k, &e) in self.face_edges[f as usize].iter().enumerate() {
+                if !std::mem::replace(&mut seen[e as usize], true) {
+                    let (a, b) = (face[k] as usize, face[(k + 1) % 3] as usize);
+                    let l0 = rest[a].distance(rest[b]);
+                    if l0 > 0.0 {
+                        stretch.push(self.cur[a].distance(self.cur[b]) / l0 - 1.0);
+                    }
+                }
+            }
+        }
+        Ok(stretch)
+    }
+
     /// Makes the current (target) position the start of the next step.
     pub(crate) fn commit(&mut self) {
         if self.prev != self.cur {
@@ -470,6 +510,99 @@ mod tests {
                 assert_eq!(a, b, "point {k} hint {hint}");
             }
         }
+    }
+
+    #[test]
+    fn skin_stretch_under_cloth_matches_a_brute_force_search() {
+        let rest = TriMesh::icosphere(2, 1.0);
+        let mut c = BodyCollider::new(&rest, 0.005).unwrap();
+        // Uniform growth by 10%: every touched edge is stretched by 10%.
+        let grown: Vec<Vec3> = rest.vertices.iter().map(|v| *v * 1.1).collect();
+        c.move_to(&grown).unwrap();
+        let near = |t: f32| -> Vec<Vec3> {
+            grown
+                .iter()
+                .step_by(5)
+                .map(|v| *v * t)
+                .chain([Vec3::X * 3.0])
+                .collect()
+        };
+        let s = c
+            .skin_stretch_under(&rest.vertices, &near(1.004), 0.01)
+            .unwrap();
+        assert!(
+            !s.is_empty() && s.iter().all(|x| (x - 0.1).abs() < 1e-5),
+            "{s:?}"
+        );
+        assert!(c
+            .skin_stretch_under(&rest.vertices, &[Vec3::X * 3.0], 0.01)
+            .unwrap()
+            .is_empty());
+        assert!(c
+            .skin_stretch_under(&rest.vertices[1..], &near(1.0), 0.01)
+            .is_err());
+        // The +x half stretched sideways only: the same edges, with the same values, as
+        // testing every face against every point.
+        let skewed: Vec<Vec3> = rest
+            .vertices
+            .iter()
+            .map(|v| {
+                if v.x > 0.0 {
+                    *v * Vec3::new(1.0, 1.3, 1.0)
+                } else {
+                    *v
+                }
+            })
+            .collect();
+        c.move_to(&skewed).unwrap();
+        // Off face centres (off vertices, faces tie for the closest).
+        let pts: Vec<Vec3> = rest
+            .faces
+            .iter()
+            .step_by(3)
+            .map(|f| {
+                let [a, b, cc] = f.map(|k| skewed[k as usize]);
+                (a + b + cc) / 3.0 + (b - a).cross(cc - a).normalize() * 0.006
+            })
+            .collect();
+        let mut fast = c.skin_stretch_under(&rest.vertices, &pts, 0.01).unwrap();
+        let mut edges = std::collections::BTreeSet::new();
+        for p in &pts {
+            let (f, d) = rest
+                .faces
+                .iter()
+                .enumerate()
+                .map(|(i, f)| {
+                    let [a, b, cc] = f.map(|k| skewed[k as usize]);
+                    (
+                        i,
+                        geom::tri::closest_point_on_triangle(*p, a, b, cc)
+                            .0
+                            .distance(*p),
+                    )
+                })
+                .min_by(|x, y| x.1.total_cmp(&y.1))
+                .unwrap();
+            if d <= 0.01 {
+                let face = rest.faces[f];
+                for k in 0..3 {
+                    let (a, b) = (face[k], face[(k + 1) % 3]);
+                    edges.insert((a.min(b), a.max(b)));
+                }
+            }
+        }
+        let mut plain: Vec<f32> = edges
+            .iter()
+            .map(|&(a, b)| {
+                let (a, b) = (a as usize, b as usize);
+                skewed[a].distance(skewed[b]) / rest.vertices[a].distance(rest.vertices[b]) - 1.0
+            })
+            .collect();
+        fast.sort_by(f32::total_cmp);
+        plain.sort_by(f32::total_cmp);
+        assert_eq!(fast.len(), plain.len());
+        assert!(fast.iter().zip(&plain).all(|(a, b)| (a - b).abs() < 1e-6));
+        assert!(plain.last().unwrap() > &0.1);
     }
 
     #[test]

@@ -17,7 +17,7 @@ use garment::GarmentTemplate;
 use geom::TriMesh;
 use glam::{Quat, Vec3};
 
-use crate::stats::DrapeStats;
+use crate::stats::{percentile, DrapeStats, SKIN_TOUCH_M};
 use crate::{BodyCollider, ClothParams, ClothSim, SimError};
 
 /// Settings of a drape.
@@ -251,6 +251,10 @@ pub fn drape(
     stats.measure(
         &collider.penetration_depths(sim.positions()),
         &sim.strains(),
+    );
+    stats.skin_stretch_p90 = percentile(
+        &collider.skin_stretch_under(&target.mesh.vertices, sim.positions(), SKIN_TOUCH_M)?,
+        0.9,
     );
     if stats.max_penetration_m > opts.max_penetration {
         return Err(SimError::Rejected(format!(
