@@ -173,7 +173,8 @@ fn markdown(cases: &[Case]) -> String {
     );
     for c in cases {
         match &c.stats {
-            Some(s) => out += &format!(
+            Some(s) => {
+                out += &format!(
                 "| {} | {} | {} | {:.2} | {} | {} | {:.2} | {:.2} | {:.1} | {:.1} | {:.0} | {} |\n",
                 c.garment,
                 c.shape_seed,
@@ -187,7 +188,8 @@ fn markdown(cases: &[Case]) -> String {
                 s.slid_m * 100.0,
                 s.limb_turn_deg,
                 s.walked_out
-            ),
+            )
+            }
             None => {
                 out += &format!(
                     "| {} | {} | {} | failed: {} | | | | | | | | |\n",

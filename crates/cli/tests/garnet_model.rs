@@ -154,8 +154,8 @@ fn train_resume_eval_and_drape() {
 
     // Export: the network without the optimiser state, and its model card.
     let shipped = tmp.path().join("models").join("tshirt-local.garnet");
-    let export = |out: &Path, filter: &str| {
-        garnet(&[
+    let export = |out: &Path, flags: &[&str]| {
+        let mut args = vec![
             "export",
             "--model",
             s(&best),
@@ -163,10 +163,11 @@ fn train_resume_eval_and_drape() {
             s(data),
             "--out",
             s(out),
-            filter,
-        ])
+        ];
+        args.extend_from_slice(flags);
+        garnet(&args)
     };
-    assert!(export(&shipped, "--max-strain=1000").status.success());
+    assert!(export(&shipped, &["--max-strain=1000"]).status.success());
     let size = |p: &Path| std::fs::metadata(p).unwrap().len();
     assert!(
         size(&shipped) * 2 < size(&best),
@@ -194,14 +195,14 @@ fn train_resume_eval_and_drape() {
     }
     // A bad filter is refused before anything is written.
     let bad_out = tmp.path().join("bad.garnet");
-    let refused = export(&bad_out, "--max-slide=-1");
+    let refused = export(&bad_out, &["--max-slide=-1"]);
     let err = String::from_utf8_lossy(&refused.stderr);
     assert!(
         !refused.status.success() && err.contains("--max-slide"),
         "{err}"
     );
     assert!(!bad_out.exists());
-    let refused = export(&tmp.path().join("model.bin"), "--at-rest");
+    let refused = export(&tmp.path().join("model.bin"), &["--at-rest"]);
     assert!(!refused.status.success());
     let err = String::from_utf8_lossy(&refused.stderr);
     assert!(!err.contains("panicked"), "{err}");
@@ -216,21 +217,8 @@ fn train_resume_eval_and_drape() {
     std::fs::create_dir_all(&twin_data).unwrap();
     let manifest = std::fs::read_to_string(data.join("manifest.json")).unwrap();
     std::fs::write(twin_data.join("manifest.json"), &manifest).unwrap();
-    let export_twin = |out: &Path, split: &str| {
-        garnet(&[
-            "export",
-            "--model",
-            s(&best),
-            "--data",
-            s(data),
-            "--train-data",
-            s(&twin_data),
-            "--split",
-            split,
-            "--out",
-            s(out),
-        ])
-    };
+    let export_twin =
+        |out: &Path, split: &str| export(out, &["--train-data", s(&twin_data), "--split", split]);
     let twin = tmp.path().join("twin.garnet");
     assert!(export_twin(&twin, "test").status.success());
     let card = std::fs::read_to_string(twin.with_extension("md")).unwrap();
