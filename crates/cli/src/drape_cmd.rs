@@ -50,6 +50,21 @@ pub struct DrapeArgs {
     /// Where the networks run.
     #[arg(long, value_enum, default_value_t = DeviceArg::Cpu)]
     pub device: DeviceArg,
+    /// Write the network's output as it is. By default garment vertices that it leaves
+    /// inside the body, or nearer its skin than the simulator's cloth thickness (4 mm), are
+    /// moved out to that distance from their closest skin point, as the simulator leaves
+    /// cloth (only vertices within 3 cm of the skin are looked at).
+    #[arg(long)]
+    pub raw: bool,
+}
+
+/// How far from the skin `garnet drape` looks for garment vertices to push out, metres.
+pub const PUSH_OUT_WITHIN: f32 = 0.03;
+
+/// The gap `garnet drape` leaves between the skin and a garment vertex it pushes out: the
+/// simulator's cloth thickness, metres.
+pub fn push_out_gap() -> f32 {
+    sim::ClothParams::default().thickness
 }
 
 /// The shipped GarNet-Local models (in [`shipped_models_dir`]): T-shirt, sweater, jeans.
@@ -99,6 +114,7 @@ impl DrapeArgs {
             body_out: Some("out/body.glb".into()),
             png: Some("out/drape.png".into()),
             device: DeviceArg::Cpu,
+            raw: false,
         })
     }
 }
@@ -133,6 +149,16 @@ pub fn run(args: &DrapeArgs) -> anyhow::Result<()> {
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
     let body = target.posed(&pose, body_skinning(&args.models, &drapers)?)?;
+    let start = Instant::now();
+    let collider = (!args.raw)
+        .then(|| sim::BodyCollider::new(&body, push_out_gap()))
+        .transpose()?;
+    if collider.is_some() {
+        eprintln!(
+            "body prepared for the push-out in {:.1} ms",
+            start.elapsed().as_secs_f64() * 1e3
+        );
+    }
     let mut scene: Vec<(String, TriMesh, [u8; 3])> = Vec::new();
     let several = args.models.len() > 1;
     for (path, draper) in args.models.iter().zip(&drapers) {
@@ -141,13 +167,21 @@ pub fn run(args: &DrapeArgs) -> anyhow::Result<()> {
         let m = warp(&template, &target, &pose, Skinning::Dqs)?;
         let warp_ms = start.elapsed().as_secs_f64() * 1e3;
         let start = Instant::now();
-        let draped = draper
+        let mut draped = draper
             .drape(&body.vertices, &m.vertices)
             .with_context(|| format!("{}: draping", path.display()))?;
         let net_ms = start.elapsed().as_secs_f64() * 1e3;
+        let start = Instant::now();
+        let pushed = collider.as_ref().map_or(String::new(), |c| {
+            let n = c.push_out(&mut draped, PUSH_OUT_WITHIN, push_out_gap());
+            format!(
+                ", {n} vertices pushed out of the body in {:.1} ms",
+                start.elapsed().as_secs_f64() * 1e3
+            )
+        });
         eprintln!(
             "{} ({} vertices, GarNet-{}) on a {:.1} cm body, {what}: warp {warp_ms:.1} ms, \
-             network {net_ms:.1} ms",
+             network {net_ms:.1} ms{pushed}",
             template.kind.name(),
             draped.len(),
             draper.setup().config.variant.name(),

@@ -19,7 +19,7 @@ use model::Draper;
 use render::plot::{Chart, Series};
 use serde::Serialize;
 
-use crate::drape_cmd::checkpoint_template;
+use crate::drape_cmd::{checkpoint_template, push_out_gap, PUSH_OUT_WITHIN};
 use crate::drape_filter_args::{keep_drapes, DrapeFilterArgs};
 use crate::eval_motion::{ByMotion, MotionRow};
 use crate::model_device::DeviceArg;
@@ -49,6 +49,11 @@ pub struct EvalArgs {
     /// Where the networks run.
     #[arg(long, value_enum, default_value_t = DeviceArg::Cpu)]
     pub device: DeviceArg,
+    /// Also report each network's drapes after `garnet drape`'s push-out (vertices inside
+    /// the body or nearer its skin than 4 mm moved out to 4 mm), as rows "GarNet-X, pushed
+    /// out" (the paper's Table 1 has the network's raw output only).
+    #[arg(long)]
+    pub push_out: bool,
 }
 
 /// One row of Table 1 and its curves.
@@ -174,6 +179,8 @@ pub struct ModelEvaluation {
     /// The dataset garment the model drapes.
     pub garment: String,
     net: Row,
+    /// The network's drapes pushed out of the body as `garnet drape` does, when asked.
+    pushed: Option<Row>,
     dqs: Row,
     timing: Timing,
     by_motion: Vec<MotionRow>,
@@ -227,13 +234,15 @@ impl EvalData {
     }
 
     /// Evaluates the model at `path` on `split` (the drapes `filter` keeps, when given; at
-    /// most `max_samples` samples of its garment).
+    /// most `max_samples` samples of its garment); with `push_out`, also its drapes pushed
+    /// out of the body as `garnet drape` does by default.
     pub fn evaluate(
         &self,
         path: &Path,
         split: &str,
         filter: Option<&DrapeFilter>,
         max_samples: Option<usize>,
+        push_out: bool,
         device: &burn::prelude::Device,
     ) -> anyhow::Result<ModelEvaluation> {
         let data = &self.data;
@@ -256,7 +265,8 @@ impl EvalData {
             path.display(),
             indices.len()
         );
-        let (mut net, mut dqs) = (Errors::default(), Errors::default());
+        let (mut net, mut pushed, mut dqs) =
+            (Errors::default(), Errors::default(), Errors::default());
         let mut by_motion = ByMotion::default();
         let (mut net_ms, mut dqs_ms, mut sim_s) = (Vec::new(), Vec::new(), Vec::new());
         let opts = BatchOptions {
@@ -279,8 +289,18 @@ impl EvalData {
                 garment::warp::warp(&template, &self.body_rest, &pose, Skinning::Dqs)?;
                 dqs_ms.push(start.elapsed().as_secs_f64() * 1e3);
                 sim_s.extend(self.sim_times.get(&s.record.index));
-                let body = Bvh::from_mesh(&TriMesh::new(a.body.clone(), self.body_faces.clone()))?;
+                let body_mesh = TriMesh::new(a.body.clone(), self.body_faces.clone());
+                let body = Bvh::from_mesh(&body_mesh)?;
                 let net_cm = net.add(&a.draped, &pred, faces, &body)?;
+                if push_out {
+                    let mut p = pred.clone();
+                    sim::BodyCollider::new(&body_mesh, push_out_gap())?.push_out(
+                        &mut p,
+                        PUSH_OUT_WITHIN,
+                        push_out_gap(),
+                    );
+                    pushed.add(&a.draped, &p, faces, &body)?;
+                }
                 let dqs_cm = dqs.add(&a.draped, &a.warped, faces, &body)?;
                 by_motion.add(&s.record.pose, net_cm, dqs_cm);
             }
@@ -288,6 +308,7 @@ impl EvalData {
         Ok(ModelEvaluation {
             by_motion: by_motion.rows(&garment, &method),
             net: net.row(&garment, &method),
+            pushed: push_out.then(|| pushed.row(&garment, &format!("{method}, pushed out"))),
             dqs: dqs.row(&garment, "DQS"),
             timing: Timing {
                 garment: garment.clone(),
@@ -317,9 +338,11 @@ pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
             &args.split,
             filter.as_ref(),
             args.max_samples,
+            args.push_out,
             &device,
         )?;
         rows.push(e.net);
+        rows.extend(e.pushed);
         if dqs_done.insert(e.garment) {
             rows.push(e.dqs);
         }

@@ -82,11 +82,25 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
     save_checkpoint(&args.out, &network, None, &ck.setup, &ck.loss, &ck.state)?;
-    let eval = data.evaluate(&args.out, &args.split, None, args.max_samples, &device)?;
+    let eval = data.evaluate(
+        &args.out,
+        &args.split,
+        None,
+        args.max_samples,
+        false,
+        &device,
+    )?;
     let filtered = filter
         .map(|f| {
-            data.evaluate(&args.out, &args.split, Some(&f), args.max_samples, &device)
-                .map(|e| (f, e))
+            data.evaluate(
+                &args.out,
+                &args.split,
+                Some(&f),
+                args.max_samples,
+                false,
+                &device,
+            )
+            .map(|e| (f, e))
         })
         .transpose()?;
     let card = model_card(

@@ -132,9 +132,11 @@ fn train_resume_eval_and_drape() {
         s(&naive.join("best.garnet")),
         "--out",
         s(&eval),
+        "--push-out",
     ]);
     for row in [
         "GarNet-local",
+        "| tshirt | GarNet-local, pushed out |",
         "GarNet-naive",
         "| tshirt | DQS |",
         "simulator / network",
@@ -262,8 +264,40 @@ fn train_resume_eval_and_drape() {
         s(&out),
         "--png",
         s(&png),
+        "--body-out",
+        s(&tmp.path().join("body.obj")),
     ]);
-    assert!(log.contains("network"), "{log}");
+    assert!(
+        log.contains("network") && log.contains("pushed out of the body"),
+        "{log}"
+    );
+    // By default the vertices the network leaves inside the body are pushed out; --raw
+    // writes the network's output as it is.
+    let raw_out = tmp.path().join("raw.obj");
+    let raw_log = ok(&[
+        "drape",
+        "--model",
+        s(&shipped),
+        "--random-shape",
+        "2",
+        "--pose-procedural",
+        "3",
+        "--out",
+        s(&raw_out),
+        "--raw",
+    ]);
+    assert!(!raw_log.contains("pushed out"), "{raw_log}");
+    let body =
+        geom::Bvh::from_mesh(&geom::io::read_mesh(&tmp.path().join("body.obj")).unwrap()).unwrap();
+    let inside = |p: &Path| {
+        let v = geom::io::read_mesh(p).unwrap().vertices;
+        body.contains_points(&v).iter().filter(|&&i| i).count()
+    };
+    let (pushed, raw) = (inside(&out), inside(&raw_out));
+    assert!(
+        raw > 0 && pushed < raw,
+        "inside the body: {pushed} pushed out, {raw} raw"
+    );
     let draped = geom::io::read_mesh(&out).unwrap();
     let template_vertices = std::fs::read_dir(data.join("templates"))
         .unwrap()

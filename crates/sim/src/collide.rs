@@ -217,6 +217,24 @@ impl BodyCollider {
             .collect()
     }
 
+    /// Moves every point of `points` (`[P]` metres) that is inside the body, or outside but
+    /// closer than `gap` metres to its surface, to `gap` outside its closest surface point
+    /// (along the surface's outward direction there); only points within `within` metres of
+    /// the surface are looked at (deeper ones are left). Returns how many moved. For a
+    /// predicted garment: cloth rests on the skin, never in it.
+    pub fn push_out(&self, points: &mut [Vec3], within: f32, gap: f32) -> usize {
+        points
+            .par_iter_mut()
+            .map(|p| match self.surface_within(*p, within, NO_FACE) {
+                Some(h) if h.signed < gap => {
+                    *p = h.point + h.out * gap;
+                    1
+                }
+                _ => 0,
+            })
+            .sum()
+    }
+
     /// How far the body's skin under the cloth is stretched: for every body edge of a face
     /// whose surface lies within `within` metres of one of `points` (`[P]` metres, the
     /// cloth), its length at the current position over its length in `rest` (`[N]` metres,
@@ -510,6 +528,23 @@ mod tests {
                 assert_eq!(a, b, "point {k} hint {hint}");
             }
         }
+    }
+
+    #[test]
+    fn push_out_puts_points_inside_or_too_close_at_the_gap() {
+        let s = TriMesh::icosphere(3, 1.0);
+        let c = BodyCollider::new(&s, 0.005).unwrap();
+        // Off the centre of a face along its normal: inside, on the surface, closer than
+        // the gap, outside it, and deeper than `within`.
+        let [a, b, cc] = s.faces[7].map(|k| s.vertices[k as usize]);
+        let (centre, n) = ((a + b + cc) / 3.0, (b - a).cross(cc - a).normalize());
+        let mut pts = [-0.03f32, 0.0, 0.001, 0.01, -0.4].map(|t| centre + n * t);
+        let before = pts;
+        assert_eq!(c.push_out(&mut pts, 0.05, 0.002), 3);
+        for p in &pts[..3] {
+            assert!((*p - (centre + n * 0.002)).length() < 1e-5, "{p}");
+        }
+        assert_eq!(pts[3..], before[3..]);
     }
 
     #[test]
