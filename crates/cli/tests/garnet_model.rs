@@ -288,7 +288,7 @@ fn train_resume_eval_and_drape() {
     ]);
     assert!(!raw_log.contains("pushed out"), "{raw_log}");
     let body =
-        geom::Bvh::from_mesh(&geom::io::read_mesh(&tmp.path().join("body.obj")).unwrap()).unwrap();
+        geom::Bvh::from_mesh(&geom::io::read_mesh(tmp.path().join("body.obj")).unwrap()).unwrap();
     let inside = |p: &Path| {
         let v = geom::io::read_mesh(p).unwrap().vertices;
         body.contains_points(&v).iter().filter(|&&i| i).count()
