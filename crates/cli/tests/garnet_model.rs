@@ -475,6 +475,8 @@ fn bench_model_reports_every_variant_against_the_dqs_warp() {
         assert_eq!(rows, count, "{variant}\n{out}");
     }
     assert!(out.contains("same drape: simulator to rest"), "{out}");
+    assert!(out.contains("same drape: push-out"), "{out}");
+    assert!(out.contains("with the push-out), "), "{out}");
     assert!(out.contains("faster than the simulator"), "{out}");
 }
 
