@@ -117,22 +117,16 @@ fn same_drape(case: &TshirtCase, runs: usize, device: &Device) -> anyhow::Result
     })?;
     let n = case.template.mesh.vertices.len();
     let sim_ms = sim.stats.wall_time_s * 1e3;
-    println!(
-        "| same drape: GarNet-Local | local | {n} | | {:.1} ({:.1}..{:.1}) | {:.1} | {:.0} |",
-        t.median_ms,
-        t.min_ms,
-        t.max_ms,
-        t.cpu_ms.unwrap_or(f64::NAN),
-        t.median_ms / (case.warp.as_secs_f64() * 1e3)
-    );
-    println!(
-        "| same drape: GarNet-Local with the push-out | local | {n} | | {:.1} ({:.1}..{:.1}) | {:.1} | {:.0} |",
-        with_push.median_ms,
-        with_push.min_ms,
-        with_push.max_ms,
-        with_push.cpu_ms.unwrap_or(f64::NAN),
-        with_push.median_ms / (case.warp.as_secs_f64() * 1e3)
-    );
+    for (what, t) in [("", &t), (" with the push-out", &with_push)] {
+        println!(
+            "| same drape: GarNet-Local{what} | local | {n} | | {:.1} ({:.1}..{:.1}) | {:.1} | {:.0} |",
+            t.median_ms,
+            t.min_ms,
+            t.max_ms,
+            t.cpu_ms.unwrap_or(f64::NAN),
+            t.median_ms / (case.warp.as_secs_f64() * 1e3)
+        );
+    }
     println!(
         "| same drape: simulator to rest | | {n} | | {sim_ms:.0} | | {:.0} |",
         sim_ms / (case.warp.as_secs_f64() * 1e3)

@@ -252,21 +252,23 @@ fn train_resume_eval_and_drape() {
     // Draping needs only the (exported) model file.
     let out = tmp.path().join("draped.obj");
     let png = tmp.path().join("draped.png");
-    let log = ok(&[
-        "drape",
-        "--model",
-        s(&shipped),
-        "--random-shape",
-        "2",
-        "--pose-procedural",
-        "3",
-        "--out",
-        s(&out),
-        "--png",
-        s(&png),
-        "--body-out",
-        s(&tmp.path().join("body.obj")),
-    ]);
+    let drape = |out: &Path, flags: &[&str]| {
+        let mut args = vec![
+            "drape",
+            "--model",
+            s(&shipped),
+            "--random-shape",
+            "2",
+            "--pose-procedural",
+            "3",
+            "--out",
+            s(out),
+        ];
+        args.extend_from_slice(flags);
+        ok(&args)
+    };
+    let body_out = tmp.path().join("body.obj");
+    let log = drape(&out, &["--png", s(&png), "--body-out", s(&body_out)]);
     assert!(
         log.contains("network") && log.contains("pushed out of the body"),
         "{log}"
@@ -274,21 +276,9 @@ fn train_resume_eval_and_drape() {
     // By default the vertices the network leaves inside the body are pushed out; --raw
     // writes the network's output as it is.
     let raw_out = tmp.path().join("raw.obj");
-    let raw_log = ok(&[
-        "drape",
-        "--model",
-        s(&shipped),
-        "--random-shape",
-        "2",
-        "--pose-procedural",
-        "3",
-        "--out",
-        s(&raw_out),
-        "--raw",
-    ]);
+    let raw_log = drape(&raw_out, &["--raw"]);
     assert!(!raw_log.contains("pushed out"), "{raw_log}");
-    let body =
-        geom::Bvh::from_mesh(&geom::io::read_mesh(tmp.path().join("body.obj")).unwrap()).unwrap();
+    let body = geom::Bvh::from_mesh(&geom::io::read_mesh(&body_out).unwrap()).unwrap();
     let inside = |p: &Path| {
         let v = geom::io::read_mesh(p).unwrap().vertices;
         body.contains_points(&v).iter().filter(|&&i| i).count()
