@@ -278,7 +278,7 @@ impl EvalData {
             for s in batch? {
                 let a = &s.arrays;
                 let start = Instant::now();
-                let pred = draper.drape(&a.body, &a.warped)?;
+                let mut pred = draper.drape(&a.body, &a.warped)?;
                 net_ms.push(start.elapsed().as_secs_f64() * 1e3);
                 // The DQS warp of the same pose (its cost does not depend on the shape).
                 let pose = Pose {
@@ -290,18 +290,24 @@ impl EvalData {
                 dqs_ms.push(start.elapsed().as_secs_f64() * 1e3);
                 sim_s.extend(self.sim_times.get(&s.record.index));
                 let body_mesh = TriMesh::new(a.body.clone(), self.body_faces.clone());
-                let body = Bvh::from_mesh(&body_mesh)?;
-                let net_cm = net.add(&a.draped, &pred, faces, &body)?;
-                if push_out {
-                    let mut p = pred.clone();
-                    sim::BodyCollider::new(&body_mesh, push_out_gap())?.push_out(
-                        &mut p,
-                        PUSH_OUT_WITHIN,
-                        push_out_gap(),
-                    );
-                    pushed.add(&a.draped, &p, faces, &body)?;
+                // With the push-out, its collider's BVH serves the inside counts too.
+                let collider = push_out
+                    .then(|| sim::BodyCollider::new(&body_mesh, push_out_gap()))
+                    .transpose()?;
+                let own_bvh;
+                let body = match &collider {
+                    Some(c) => c.bvh(),
+                    None => {
+                        own_bvh = Bvh::from_mesh(&body_mesh)?;
+                        &own_bvh
+                    }
+                };
+                let net_cm = net.add(&a.draped, &pred, faces, body)?;
+                if let Some(c) = &collider {
+                    c.push_out(&mut pred, PUSH_OUT_WITHIN, push_out_gap());
+                    pushed.add(&a.draped, &pred, faces, body)?;
                 }
-                let dqs_cm = dqs.add(&a.draped, &a.warped, faces, &body)?;
+                let dqs_cm = dqs.add(&a.draped, &a.warped, faces, body)?;
                 by_motion.add(&s.record.pose, net_cm, dqs_cm);
             }
         }

@@ -175,20 +175,23 @@ fn markdown(cases: &[Case]) -> String {
         match &c.stats {
             Some(s) => {
                 out += &format!(
-                "| {} | {} | {} | {:.2} | {} | {} | {:.2} | {:.2} | {:.1} | {:.1} | {:.0} | {} |\n",
-                c.garment,
-                c.shape_seed,
-                c.pose,
-                s.wall_time_s,
-                s.animation_steps + s.settle_steps,
-                if s.converged { "yes" } else { "no" },
-                s.max_penetration_m * 1e3,
-                s.strain_p99 * 100.0,
-                s.skin_stretch_p90 * 100.0,
-                s.slid_m * 100.0,
-                s.limb_turn_deg,
-                s.walked_out
-            )
+                    concat!(
+                        "| {} | {} | {} | {:.2} | {} | {} | {:.2} | {:.2} | {:.1} | {:.1} | ",
+                        "{:.0} | {} |\n"
+                    ),
+                    c.garment,
+                    c.shape_seed,
+                    c.pose,
+                    s.wall_time_s,
+                    s.animation_steps + s.settle_steps,
+                    if s.converged { "yes" } else { "no" },
+                    s.max_penetration_m * 1e3,
+                    s.strain_p99 * 100.0,
+                    s.skin_stretch_p90 * 100.0,
+                    s.slid_m * 100.0,
+                    s.limb_turn_deg,
+                    s.walked_out
+                )
             }
             None => {
                 out += &format!(

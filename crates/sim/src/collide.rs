@@ -196,6 +196,11 @@ impl BodyCollider {
         &self.faces
     }
 
+    /// The BVH of the body where it is now (the target of the pending motion).
+    pub fn bvh(&self) -> &Bvh {
+        &self.bvh_cur
+    }
+
     /// Largest body vertex displacement of the pending motion (metres).
     pub fn max_displacement(&self) -> f32 {
         self.max_disp
