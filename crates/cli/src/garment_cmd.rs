@@ -86,6 +86,10 @@ pub struct MakeArgs {
     /// Jeans: hip joint to hem along the leg, metres.
     #[arg(long)]
     pub leg_length: Option<f32>,
+    /// Extra ease at the sleeve cuffs or trouser hems, metres, growing from halfway along
+    /// the limb: straight sleeves and legs.
+    #[arg(long)]
+    pub flare: Option<f32>,
     /// Template file to write (default out/KIND.garment).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -212,6 +216,7 @@ fn make(model: &BodyModel, args: &MakeArgs) -> anyhow::Result<()> {
         neckline_depth: args.neckline_depth.unwrap_or(d.neckline_depth),
         waist_height: args.waist_height.unwrap_or(d.waist_height),
         leg_length: args.leg_length.unwrap_or(d.leg_length),
+        flare: args.flare.unwrap_or(d.flare),
     };
     let t0 = std::time::Instant::now();
     let template = build_template(model, &kind, &cut, args.edge)?;

@@ -77,6 +77,10 @@ pub struct SimulateArgs {
     /// With --sheet: template edge length, metres.
     #[arg(long, default_value_t = 0.01)]
     pub edge: f32,
+    /// With --sheet: the garments' flare, metres (extra ease at the sleeve cuffs and trouser
+    /// hems, as `garnet garment make --flare`).
+    #[arg(long, default_value_t = 0.0)]
+    pub flare: f32,
     /// With --sheet: folder of the CMU clips.
     #[arg(long, value_name = "DIR", default_value = "../shared/mocap/cmu")]
     pub mocap: PathBuf,
@@ -86,7 +90,11 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let model = BodyModel::load()?;
     let opts = drape_options(args)?;
     if let Some(sheet) = &args.sheet {
-        return crate::simulate_sheet::write_sheet(&model, sheet, &args.mocap, args.edge, &opts);
+        let templates = crate::simulate_sheet::SheetTemplates {
+            edge: args.edge,
+            flare: args.flare,
+        };
+        return crate::simulate_sheet::write_sheet(&model, sheet, &args.mocap, &templates, &opts);
     }
     let path = args
         .template

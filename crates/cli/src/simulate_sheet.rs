@@ -55,15 +55,24 @@ fn case_pose(i: u64, mocap: &Path) -> PoseArgs {
     }
 }
 
-/// Runs the thirty drapes with templates of `edge` metres, writes `png`, and the
-/// statistics beside it (`.json`, `.md`).
+/// How the sheet's garments are built: each kind's default cut with `flare`.
+pub struct SheetTemplates {
+    /// Template edge length, metres.
+    pub edge: f32,
+    /// The cuts' flare, metres ([`CutParams::flare`]).
+    pub flare: f32,
+}
+
+/// Runs the thirty drapes with `templates`, writes `png`, and the statistics beside it
+/// (`.json`, `.md`).
 pub fn write_sheet(
     model: &BodyModel,
     png: &Path,
     mocap: &Path,
-    edge: f32,
+    templates: &SheetTemplates,
     opts: &DrapeOptions,
 ) -> anyhow::Result<()> {
+    let edge = templates.edge;
     let kinds = [
         GarmentKind::Tshirt,
         GarmentKind::Sweater,
@@ -76,13 +85,21 @@ pub fn write_sheet(
         },
         ..RenderOptions::default()
     };
+    let flare = match templates.flare {
+        f if f > 0.0 => format!(", {} cm flare", f * 100.0),
+        _ => String::new(),
+    };
     let mut sheet = Sheet::new(10).with_title(format!(
-        "garnet simulate: 30 drapes, templates with {} cm edges",
+        "garnet simulate: 30 drapes, templates with {} cm edges{flare}",
         edge * 100.0
     ));
     let mut cases = Vec::new();
     for kind in &kinds {
-        let template = build_template(model, kind, &CutParams::default_for(kind), edge)?;
+        let cut = CutParams {
+            flare: templates.flare,
+            ..CutParams::default_for(kind)
+        };
+        let template = build_template(model, kind, &cut, edge)?;
         let template_body = model.shape(&template.body_phenotype)?;
         for i in 0..10u64 {
             let shape = ShapeArgs {

@@ -191,6 +191,8 @@ fn garment_make_import_warp() {
         "jeans",
         "--edge",
         "0.03",
+        "--flare",
+        "0.03",
         "--out",
         s(&p("j.garment")),
         "--mesh",
@@ -200,6 +202,7 @@ fn garment_make_import_warp() {
     ]);
     let t = garment::GarmentTemplate::load(&p("j.garment")).unwrap();
     assert_eq!(t.kind, garment::GarmentKind::Jeans);
+    assert_eq!(t.cut.unwrap().flare, 0.03);
     assert_eq!(
         geom::io::read_mesh(p("j.obj")).unwrap().vertices.len(),
         t.mesh.vertices.len()
@@ -252,6 +255,15 @@ fn garment_commands_refuse_bad_input() {
         s(&p("t.garment")),
     ]);
     assert!(err.contains("ease"), "{err}");
+    let err = fails(&[
+        "garment",
+        "make",
+        "jeans",
+        "--flare=-0.01",
+        "--out",
+        s(&p("t.garment")),
+    ]);
+    assert!(err.contains("flare"), "{err}");
     assert!(!p("t.garment").exists());
     // A box a metre away from the body is not a garment for it.
     let mut cube = geom::TriMesh::cuboid(glam::Vec3::splat(0.15));

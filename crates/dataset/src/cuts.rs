@@ -32,7 +32,8 @@ fn set(cut: &mut CutParams, index: usize, value: f32) {
         2 => &mut cut.ease,
         3 => &mut cut.neckline_depth,
         4 => &mut cut.waist_height,
-        _ => &mut cut.leg_length,
+        5 => &mut cut.leg_length,
+        _ => &mut cut.flare,
     };
     *field = value;
 }
@@ -152,6 +153,16 @@ mod tests {
         let f = GarmentPlan::from_spec(&fixed).unwrap();
         assert_eq!(f.cut_for(1, 0, 3), f.base);
         assert_eq!(f.template_id(3), "sweater");
+    }
+
+    #[test]
+    fn every_cut_parameter_is_set_by_its_name() {
+        for (i, (name, lo, hi)) in RANGES.iter().enumerate() {
+            let mut cut = CutParams::default_for(&GarmentKind::Jeans);
+            let v = 0.5 * (lo + hi);
+            set(&mut cut, param_index(name).unwrap(), v);
+            assert_eq!(cut.named()[i], (*name, v));
+        }
     }
 
     #[test]

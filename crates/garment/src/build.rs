@@ -14,6 +14,9 @@ use crate::{CutParams, GarmentError, GarmentKind};
 /// Smallest and largest target edge length accepted, metres.
 pub const EDGE_RANGE: (f32, f32) = (0.004, 0.08);
 
+/// Where along a sleeve or trouser leg (as a fraction of its cut length) the flare starts.
+pub const FLARE_FROM: f32 = 0.25;
+
 /// Builds the template of `kind` with `cut`, remeshed to edges of about `edge` metres
 /// (1 cm gives about 10k vertices for the T-shirt), on the template body (the default
 /// phenotype in rest pose).
@@ -34,7 +37,12 @@ pub fn build_template(
     let bvh = Bvh::from_mesh(&body.mesh)?;
     let mut region = garment_region(&body, kind, cut)?;
     let opts = InflateOptions::for_ease(cut.ease);
-    inflate(&mut region.mesh, &bvh, &opts)?;
+    let flare: Vec<f32> = region
+        .along_limb
+        .iter()
+        .map(|&t| cut.flare * ((t - FLARE_FROM) / (1.0 - FLARE_FROM)).clamp(0.0, 1.0))
+        .collect();
+    inflate(&mut region.mesh, &flare, &bvh, &opts)?;
     let remeshed = isotropic_remesh(&region.mesh, &RemeshOptions::new(edge))?;
     let mut mesh = remeshed.mesh;
     push_out(&mut mesh.vertices, &bvh, opts.min_gap);

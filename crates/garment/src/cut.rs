@@ -76,16 +76,23 @@ pub struct CutParams {
     pub waist_height: f32,
     /// Jeans: from the hip joint along the leg to the hem.
     pub leg_length: f32,
+    /// Extra ease at the limb openings (sleeve cuffs, trouser hems): none up to halfway
+    /// along the sleeve or leg, growing linearly to this at the opening, so the sleeve or
+    /// leg hangs straight instead of following the arm or calf. Absent in files written
+    /// before it existed, where it is 0.
+    #[serde(default)]
+    pub flare: f32,
 }
 
 /// Valid range of each parameter, `(name, min, max)`.
-pub const RANGES: [(&str, f32, f32); 6] = [
+pub const RANGES: [(&str, f32, f32); 7] = [
     ("body_length", 0.35, 0.62),
     ("sleeve_length", 0.06, 0.5),
     ("ease", 0.005, 0.06),
     ("neckline_depth", 0.0, 0.12),
     ("waist_height", -0.06, 0.14),
     ("leg_length", 0.2, 0.8),
+    ("flare", 0.0, 0.08),
 ];
 
 impl CutParams {
@@ -115,10 +122,11 @@ impl CutParams {
         neckline_depth: 0.04,
         waist_height: 0.04,
         leg_length: 0.75,
+        flare: 0.0,
     };
 
     /// `(name, value)` of every parameter, in [`RANGES`] order.
-    pub fn named(&self) -> [(&'static str, f32); 6] {
+    pub fn named(&self) -> [(&'static str, f32); 7] {
         [
             ("body_length", self.body_length),
             ("sleeve_length", self.sleeve_length),
@@ -126,6 +134,7 @@ impl CutParams {
             ("neckline_depth", self.neckline_depth),
             ("waist_height", self.waist_height),
             ("leg_length", self.leg_length),
+            ("flare", self.flare),
         ]
     }
 
@@ -163,5 +172,14 @@ mod tests {
             ..CutParams::default_for(&GarmentKind::Tshirt)
         };
         assert!(bad.validate().is_err());
+    }
+
+    #[test]
+    fn cuts_written_before_the_flare_read_as_unflared() {
+        let json = r#"{"body_length":0.59,"sleeve_length":0.28,"ease":0.04,
+            "neckline_depth":0.04,"waist_height":0.04,"leg_length":0.75}"#;
+        let cut: CutParams = serde_json::from_str(json).unwrap();
+        assert_eq!(cut, CutParams::default_for(&GarmentKind::Tshirt));
+        assert_eq!(cut.flare, 0.0);
     }
 }

@@ -37,16 +37,25 @@ impl InflateOptions {
 }
 
 /// Inflates `region` (a part of the body surface `body`, same units) in place:
-/// offset along the normals by the ease, then smoothing rounds that keep every vertex
-/// at least `min_gap` outside the body. Openings are smoothed along themselves only.
+/// offset along the normals by the ease plus each vertex's `extra` (`[n]` metres), then
+/// smoothing rounds that keep every vertex at least `min_gap` outside the body. Openings
+/// are smoothed along themselves only.
 pub fn inflate(
     region: &mut TriMesh,
+    extra: &[f32],
     body: &Bvh,
     opts: &InflateOptions,
 ) -> Result<(), GarmentError> {
+    if extra.len() != region.vertices.len() {
+        return Err(GarmentError::Parameter(format!(
+            "{} extra offsets for {} region vertices",
+            extra.len(),
+            region.vertices.len()
+        )));
+    }
     let normals = geom::normals::vertex_normals(&region.vertices, &region.faces);
-    for (p, nrm) in region.vertices.iter_mut().zip(&normals) {
-        *p += *nrm * opts.ease;
+    for ((p, nrm), e) in region.vertices.iter_mut().zip(&normals).zip(extra) {
+        *p += *nrm * (opts.ease + e);
     }
     let smoother = Smoother::new(region.vertices.len(), &region.faces)?;
     let phases = [

@@ -21,7 +21,13 @@ pub struct Region {
     pub mesh: TriMesh,
     /// `[n]` body vertex index of every region vertex.
     pub body_vertex: Vec<u32>,
+    /// `[n]` how far along its sleeve or trouser leg each region vertex lies, as a fraction
+    /// of the cut's sleeve or leg length (0 on the torso, 1 at the opening).
+    pub along_limb: Vec<f32>,
 }
+
+/// A bone as its head and tail, metres.
+type BoneLine = (Vec3, Vec3);
 
 /// Enclosed gaps smaller than this many faces are filled.
 const MAX_GAP_FACES: usize = 400;
@@ -45,8 +51,22 @@ pub fn covered_vertices(
     kind: &GarmentKind,
     cut: &CutParams,
 ) -> Result<Vec<bool>, GarmentError> {
+    Ok(coverage(body, kind, cut)?
+        .iter()
+        .map(Option::is_some)
+        .collect())
+}
+
+/// For every body vertex (`[V]`): `None` where the garment does not cover it, else how far
+/// along the sleeve or trouser leg it lies as a fraction of the cut's sleeve or leg length
+/// (0 on the torso, 1 at the opening).
+fn coverage(
+    body: &ShapedBody,
+    kind: &GarmentKind,
+    cut: &CutParams,
+) -> Result<Vec<Option<f32>>, GarmentError> {
     let rig = &body.rig;
-    let bone = |name: &str| -> Result<(Vec3, Vec3), GarmentError> {
+    let bone = |name: &str| -> Result<BoneLine, GarmentError> {
         let b = rig
             .index(name)
             .ok_or_else(|| GarmentError::Parameter(format!("the rig has no bone {name}")))?;
@@ -59,7 +79,14 @@ pub fn covered_vertices(
         .map(|b| b.name.contains("Hand") || b.name.contains("Finger") || b.name.contains("Thumb"))
         .collect();
     let v = &body.mesh.vertices;
-    let keep: Vec<bool> = match kind {
+    // The fraction along the limb of a vertex on limb segment `s` within `length`.
+    let along = |p: Vec3, s: u8, chains: &[(BoneLine, BoneLine, u8, u8)], length: f32| {
+        chains.iter().find_map(|&(up, low, su, sl)| {
+            let d = along_chain(p, up, low, s == sl);
+            ((s == su || s == sl) && d <= length).then(|| (d / length).max(0.0))
+        })
+    };
+    let keep: Vec<Option<f32>> = match kind {
         GarmentKind::Tshirt | GarmentKind::Sweater => {
             let neck = bone("Neck")?.0;
             let hem = neck.y - cut.body_length;
@@ -80,13 +107,9 @@ pub fn covered_vertices(
                     let front = ((p.z - neck.z) / 0.05).clamp(0.0, 1.0);
                     let below_neckline = p.y < neck.y + 0.01 - cut.neckline_depth * front;
                     match s {
-                        0 | 5 | 7 => p.y >= hem && below_neckline,
-                        _ if is_hand[body.weights.heaviest(i)] => false,
-                        _ => arms.iter().any(|&(up, low, su, sl)| {
-                            (s == su || s == sl)
-                                && along_chain(p, up, low, s == sl) <= cut.sleeve_length
-                                && p.y >= hem
-                        }),
+                        0 | 5 | 7 => (p.y >= hem && below_neckline).then_some(0.0),
+                        _ if is_hand[body.weights.heaviest(i)] || p.y < hem => None,
+                        _ => along(p, s, &arms, cut.sleeve_length),
                     }
                 })
                 .collect()
@@ -101,13 +124,9 @@ pub fn covered_vertices(
                 .map(|i| {
                     let (p, s) = (v[i], seg[i]);
                     match s {
-                        0 => p.y <= waist,
-                        1..=4 => false,
-                        _ => legs.iter().any(|&(up, low, su, sl)| {
-                            (s == su || s == sl)
-                                && along_chain(p, up, low, s == sl) <= cut.leg_length
-                                && p.y <= waist
-                        }),
+                        0 => (p.y <= waist).then_some(0.0),
+                        _ if (1..=4).contains(&s) || p.y > waist => None,
+                        _ => along(p, s, &legs, cut.leg_length),
                     }
                 })
                 .collect()
@@ -128,14 +147,19 @@ pub fn garment_region(
     kind: &GarmentKind,
     cut: &CutParams,
 ) -> Result<Region, GarmentError> {
-    let keep = covered_vertices(body, kind, cut)?;
+    let cover = coverage(body, kind, cut)?;
     let faces = &body.mesh.faces;
     let mut in_region: Vec<bool> = faces
         .iter()
-        .map(|f| f.iter().all(|&i| keep[i as usize]))
+        .map(|f| f.iter().all(|&i| cover[i as usize].is_some()))
         .collect();
     fill_small_gaps(faces, body.mesh.vertices.len(), &mut in_region)?;
-    let region = extract(&body.mesh, &in_region);
+    let mut region = extract(&body.mesh, &in_region);
+    region.along_limb = region
+        .body_vertex
+        .iter()
+        .map(|&i| cover[i as usize].unwrap_or(0.0))
+        .collect();
     let loops = geom::adjacency::boundary_loops(region.mesh.vertices.len(), &region.mesh.faces)?;
     if let Some(expected) = kind.openings() {
         if loops.len() != expected {
@@ -209,6 +233,7 @@ fn extract(mesh: &TriMesh, in_region: &[bool]) -> Region {
         .collect();
     Region {
         mesh: TriMesh { vertices, faces },
+        along_limb: vec![0.0; body_vertex.len()],
         body_vertex,
     }
 }

@@ -238,3 +238,67 @@ fn fitted_warp_is_the_identity_at_rest_and_follows_girth() {
         );
     }
 }
+
+/// Each opening of `t` as (centroid, mean gap to the skin), metres.
+fn openings(t: &GarmentTemplate, bvh: &Bvh) -> Vec<(Vec3, f32)> {
+    let m = &t.mesh;
+    geom::adjacency::boundary_loops(m.vertices.len(), &m.faces)
+        .unwrap()
+        .iter()
+        .map(|l| {
+            let n = l.len() as f32;
+            let points = l.iter().map(|&i| m.vertices[i as usize]);
+            let centroid = points.clone().sum::<Vec3>() / n;
+            let gap = points
+                .map(|p| bvh.closest_point(p).unwrap().distance)
+                .sum::<f32>()
+                / n;
+            (centroid, gap)
+        })
+        .collect()
+}
+
+#[test]
+fn flare_widens_the_sleeve_and_leg_openings_only() {
+    let body = model().shape(&Phenotype::default()).unwrap();
+    let bvh = Bvh::from_mesh(&body.mesh).unwrap();
+    let flare = 0.03;
+    for (plain, kind) in templates().iter().zip([
+        GarmentKind::Tshirt,
+        GarmentKind::Sweater,
+        GarmentKind::Jeans,
+    ]) {
+        let cut = CutParams {
+            flare,
+            ..CutParams::default_for(&kind)
+        };
+        let flared = build_template(model(), &kind, &cut, EDGE).unwrap();
+        let before = openings(plain, &bvh);
+        let mut widened = 0;
+        for (centroid, gap) in openings(&flared, &bvh) {
+            let (_, old) = before
+                .iter()
+                .min_by(|a, b| a.0.distance(centroid).total_cmp(&b.0.distance(centroid)))
+                .unwrap();
+            let grown = gap - old;
+            // The body's openings (neck, hem, waist) keep their ease; the sleeves' cuffs
+            // and the trouser hems gain at least half the flare (smoothing and the feet take
+            // some).
+            if centroid.x.abs() > 0.12 || (kind == GarmentKind::Jeans && centroid.y < 0.5) {
+                assert!(
+                    grown > 0.5 * flare,
+                    "{}: an opening at {centroid} grew {grown} m",
+                    kind.name()
+                );
+                widened += 1;
+            } else {
+                assert!(
+                    grown.abs() < 0.005,
+                    "{}: the opening at {centroid} moved {grown} m",
+                    kind.name()
+                );
+            }
+        }
+        assert_eq!(widened, 2, "{}", kind.name());
+    }
+}
