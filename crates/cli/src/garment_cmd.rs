@@ -90,6 +90,10 @@ pub struct MakeArgs {
     /// the limb: straight sleeves and legs.
     #[arg(long)]
     pub flare: Option<f32>,
+    /// How much the cloth spans the body's hollows (armpits, gluteal cleft) instead of
+    /// following them, 0 to 1 (a fraction of the default bridging smoothing).
+    #[arg(long)]
+    pub bridge: Option<f32>,
     /// Template file to write (default out/KIND.garment).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -217,6 +221,7 @@ fn make(model: &BodyModel, args: &MakeArgs) -> anyhow::Result<()> {
         waist_height: args.waist_height.unwrap_or(d.waist_height),
         leg_length: args.leg_length.unwrap_or(d.leg_length),
         flare: args.flare.unwrap_or(d.flare),
+        bridge: args.bridge.unwrap_or(d.bridge),
     };
     let t0 = std::time::Instant::now();
     let template = build_template(model, &kind, &cut, args.edge)?;

@@ -81,6 +81,10 @@ pub struct SimulateArgs {
     /// hems, as `garnet garment make --flare`).
     #[arg(long, default_value_t = 0.0)]
     pub flare: f32,
+    /// With --sheet: how much the garments span the body's hollows, 0 to 1 (as `garnet
+    /// garment make --bridge`).
+    #[arg(long, default_value_t = 1.0)]
+    pub bridge: f32,
     /// With --sheet: folder of the CMU clips.
     #[arg(long, value_name = "DIR", default_value = "../shared/mocap/cmu")]
     pub mocap: PathBuf,
@@ -93,6 +97,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         let templates = crate::simulate_sheet::SheetTemplates {
             edge: args.edge,
             flare: args.flare,
+            bridge: args.bridge,
         };
         return crate::simulate_sheet::write_sheet(&model, sheet, &args.mocap, &templates, &opts);
     }

@@ -55,12 +55,14 @@ fn case_pose(i: u64, mocap: &Path) -> PoseArgs {
     }
 }
 
-/// How the sheet's garments are built: each kind's default cut with `flare`.
+/// How the sheet's garments are built: each kind's default cut with `flare` and `bridge`.
 pub struct SheetTemplates {
     /// Template edge length, metres.
     pub edge: f32,
     /// The cuts' flare, metres ([`CutParams::flare`]).
     pub flare: f32,
+    /// The cuts' bridge, 0 to 1 ([`CutParams::bridge`]).
+    pub bridge: f32,
 }
 
 /// Runs the thirty drapes with `templates`, writes `png`, and the statistics beside it
@@ -85,18 +87,22 @@ pub fn write_sheet(
         },
         ..RenderOptions::default()
     };
-    let flare = match templates.flare {
-        f if f > 0.0 => format!(", {} cm flare", f * 100.0),
-        _ => String::new(),
-    };
+    let mut cut_note = String::new();
+    if templates.flare > 0.0 {
+        cut_note += &format!(", {} cm flare", templates.flare * 100.0);
+    }
+    if templates.bridge < 1.0 {
+        cut_note += &format!(", bridge {}", templates.bridge);
+    }
     let mut sheet = Sheet::new(10).with_title(format!(
-        "garnet simulate: 30 drapes, templates with {} cm edges{flare}",
+        "garnet simulate: 30 drapes, templates with {} cm edges{cut_note}",
         edge * 100.0
     ));
     let mut cases = Vec::new();
     for kind in &kinds {
         let cut = CutParams {
             flare: templates.flare,
+            bridge: templates.bridge,
             ..CutParams::default_for(kind)
         };
         let template = build_template(model, kind, &cut, edge)?;

@@ -193,6 +193,8 @@ fn garment_make_import_warp() {
         "0.03",
         "--flare",
         "0.03",
+        "--bridge",
+        "0.5",
         "--out",
         s(&p("j.garment")),
         "--mesh",
@@ -202,7 +204,7 @@ fn garment_make_import_warp() {
     ]);
     let t = garment::GarmentTemplate::load(&p("j.garment")).unwrap();
     assert_eq!(t.kind, garment::GarmentKind::Jeans);
-    assert_eq!(t.cut.unwrap().flare, 0.03);
+    assert_eq!((t.cut.unwrap().flare, t.cut.unwrap().bridge), (0.03, 0.5));
     assert_eq!(
         geom::io::read_mesh(p("j.obj")).unwrap().vertices.len(),
         t.mesh.vertices.len()

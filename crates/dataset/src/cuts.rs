@@ -24,7 +24,7 @@ pub struct GarmentPlan {
     pub ranges: Vec<(usize, f32, f32)>,
 }
 
-/// Sets parameter `index` (of [`RANGES`]) of `cut` to `value` metres.
+/// Sets parameter `index` (of [`RANGES`]) of `cut` to `value` (metres, or a fraction).
 fn set(cut: &mut CutParams, index: usize, value: f32) {
     let field = match index {
         0 => &mut cut.body_length,
@@ -33,7 +33,8 @@ fn set(cut: &mut CutParams, index: usize, value: f32) {
         3 => &mut cut.neckline_depth,
         4 => &mut cut.waist_height,
         5 => &mut cut.leg_length,
-        _ => &mut cut.flare,
+        6 => &mut cut.flare,
+        _ => &mut cut.bridge,
     };
     *field = value;
 }

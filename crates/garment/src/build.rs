@@ -36,7 +36,7 @@ pub fn build_template(
     let body = model.shape(&Phenotype::default())?;
     let bvh = Bvh::from_mesh(&body.mesh)?;
     let mut region = garment_region(&body, kind, cut)?;
-    let opts = InflateOptions::for_ease(cut.ease);
+    let opts = InflateOptions::new(cut.ease, cut.bridge);
     let flare: Vec<f32> = region
         .along_limb
         .iter()

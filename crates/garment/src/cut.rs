@@ -82,10 +82,21 @@ pub struct CutParams {
     /// before it existed, where it is 0.
     #[serde(default)]
     pub flare: f32,
+    /// How much the cloth spans the body's hollows (the armpits, the gluteal cleft, between
+    /// the breasts) instead of following them into the folds, 0 to 1: the share of the
+    /// template's bridging smoothing rounds kept (a fraction, not metres). Spanning the
+    /// armpit leaves less cloth there than a raised arm unfolds the skin into. Absent in
+    /// files written before it existed, where it is 1.
+    #[serde(default = "full_bridge")]
+    pub bridge: f32,
 }
 
-/// Valid range of each parameter, `(name, min, max)`.
-pub const RANGES: [(&str, f32, f32); 7] = [
+fn full_bridge() -> f32 {
+    1.0
+}
+
+/// Valid range of each parameter, `(name, min, max)`: metres, except `bridge` (a fraction).
+pub const RANGES: [(&str, f32, f32); 8] = [
     ("body_length", 0.35, 0.62),
     ("sleeve_length", 0.06, 0.5),
     ("ease", 0.005, 0.06),
@@ -93,6 +104,7 @@ pub const RANGES: [(&str, f32, f32); 7] = [
     ("waist_height", -0.06, 0.14),
     ("leg_length", 0.2, 0.8),
     ("flare", 0.0, 0.08),
+    ("bridge", 0.0, 1.0),
 ];
 
 impl CutParams {
@@ -123,10 +135,11 @@ impl CutParams {
         waist_height: 0.04,
         leg_length: 0.75,
         flare: 0.0,
+        bridge: 1.0,
     };
 
     /// `(name, value)` of every parameter, in [`RANGES`] order.
-    pub fn named(&self) -> [(&'static str, f32); 7] {
+    pub fn named(&self) -> [(&'static str, f32); 8] {
         [
             ("body_length", self.body_length),
             ("sleeve_length", self.sleeve_length),
@@ -135,6 +148,7 @@ impl CutParams {
             ("waist_height", self.waist_height),
             ("leg_length", self.leg_length),
             ("flare", self.flare),
+            ("bridge", self.bridge),
         ]
     }
 
@@ -168,6 +182,11 @@ mod tests {
         };
         assert!(bad.validate().unwrap_err().to_string().contains("ease"));
         let bad = CutParams {
+            bridge: 1.5,
+            ..CutParams::default_for(&GarmentKind::Jeans)
+        };
+        assert!(bad.validate().unwrap_err().to_string().contains("bridge"));
+        let bad = CutParams {
             sleeve_length: 2.0,
             ..CutParams::default_for(&GarmentKind::Tshirt)
         };
@@ -175,11 +194,11 @@ mod tests {
     }
 
     #[test]
-    fn cuts_written_before_the_flare_read_as_unflared() {
+    fn cuts_written_before_flare_and_bridge_read_as_before() {
         let json = r#"{"body_length":0.59,"sleeve_length":0.28,"ease":0.04,
             "neckline_depth":0.04,"waist_height":0.04,"leg_length":0.75}"#;
         let cut: CutParams = serde_json::from_str(json).unwrap();
         assert_eq!(cut, CutParams::default_for(&GarmentKind::Tshirt));
-        assert_eq!(cut.flare, 0.0);
+        assert_eq!((cut.flare, cut.bridge), (0.0, 1.0));
     }
 }

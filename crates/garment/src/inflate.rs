@@ -24,13 +24,17 @@ pub struct InflateOptions {
     pub rounds: u32,
 }
 
+/// Bridging rounds of a cut with `bridge` 1.
+pub const BRIDGE_ROUNDS: u32 = 12;
+
 impl InflateOptions {
-    /// Options for a garment of the given ease (metres).
-    pub fn for_ease(ease: f32) -> Self {
+    /// Options for a garment of `ease` metres spanning the body's hollows by `bridge` (0 to
+    /// 1, the share of [`BRIDGE_ROUNDS`]).
+    pub fn new(ease: f32, bridge: f32) -> Self {
         Self {
             ease,
             min_gap: (0.4 * ease).max(0.004),
-            bridge_rounds: 12,
+            bridge_rounds: (BRIDGE_ROUNDS as f32 * bridge.clamp(0.0, 1.0)).round() as u32,
             rounds: 40,
         }
     }

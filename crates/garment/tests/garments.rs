@@ -302,3 +302,31 @@ fn flare_widens_the_sleeve_and_leg_openings_only() {
         assert_eq!(widened, 2, "{}", kind.name());
     }
 }
+
+#[test]
+fn a_cut_without_bridging_follows_the_hollows_with_more_cloth() {
+    let body = model().shape(&Phenotype::default()).unwrap();
+    let bvh = Bvh::from_mesh(&body.mesh).unwrap();
+    let area = |m: &TriMesh| {
+        geom::normals::face_areas(&m.vertices, &m.faces)
+            .iter()
+            .sum::<f32>()
+    };
+    let spanning = &templates()[0];
+    let kind = GarmentKind::Tshirt;
+    let cut = CutParams {
+        bridge: 0.0,
+        ..CutParams::default_for(&kind)
+    };
+    let following = build_template(model(), &kind, &cut, EDGE).unwrap();
+    let (a0, a1) = (area(&spanning.mesh), area(&following.mesh));
+    // Measured: 10% more cloth.
+    assert!(a1 > 1.05 * a0, "area {a1} m^2 against {a0} m^2");
+    let inside = following
+        .mesh
+        .vertices
+        .iter()
+        .filter(|p| bvh.contains(**p))
+        .count();
+    assert_eq!(inside, 0);
+}
