@@ -77,14 +77,11 @@ pub struct SimulateArgs {
     /// With --sheet: template edge length, metres.
     #[arg(long, default_value_t = 0.01)]
     pub edge: f32,
-    /// With --sheet: the garments' flare, metres (extra ease at the sleeve cuffs and trouser
-    /// hems, as `garnet garment make --flare`).
-    #[arg(long, default_value_t = 0.0)]
-    pub flare: f32,
-    /// With --sheet: how much the garments span the body's hollows, 0 to 1 (as `garnet
-    /// garment make --bridge`).
-    #[arg(long, default_value_t = 1.0)]
-    pub bridge: f32,
+    /// With --sheet: a garment's cut as `KIND:KEY=VALUE[,KEY=VALUE...]` with the parameters
+    /// of `garnet garment make` (e.g. `tshirt:flare=0.03,bridge=0`); repeatable. Garments
+    /// it does not name keep their default cut.
+    #[arg(long = "cut", value_name = "KIND:SETTINGS")]
+    pub cuts: Vec<String>,
     /// With --sheet: folder of the CMU clips.
     #[arg(long, value_name = "DIR", default_value = "../shared/mocap/cmu")]
     pub mocap: PathBuf,
@@ -96,8 +93,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     if let Some(sheet) = &args.sheet {
         let templates = crate::simulate_sheet::SheetTemplates {
             edge: args.edge,
-            flare: args.flare,
-            bridge: args.bridge,
+            cuts: args.cuts.clone(),
         };
         return crate::simulate_sheet::write_sheet(&model, sheet, &args.mocap, &templates, &opts);
     }

@@ -55,14 +55,32 @@ fn case_pose(i: u64, mocap: &Path) -> PoseArgs {
     }
 }
 
-/// How the sheet's garments are built: each kind's default cut with `flare` and `bridge`.
+/// How the sheet's garments are built.
 pub struct SheetTemplates {
     /// Template edge length, metres.
     pub edge: f32,
-    /// The cuts' flare, metres ([`CutParams::flare`]).
-    pub flare: f32,
-    /// The cuts' bridge, 0 to 1 ([`CutParams::bridge`]).
-    pub bridge: f32,
+    /// Cut settings `KIND:KEY=VALUE[,KEY=VALUE...]` ([`CutParams::apply`]); a kind not
+    /// named keeps its default cut.
+    pub cuts: Vec<String>,
+}
+
+impl SheetTemplates {
+    /// The cut of `kind`: its default with the settings naming it. Errors on a setting for
+    /// no garment of the sheet or a bad one, quoting it.
+    fn cut(&self, kind: &GarmentKind) -> anyhow::Result<CutParams> {
+        let mut cut = CutParams::default_for(kind);
+        for setting in &self.cuts {
+            let (name, settings) = setting.split_once(':').ok_or_else(|| {
+                anyhow::anyhow!("--cut '{setting}': expected KIND:KEY=VALUE[,KEY=VALUE...]")
+            })?;
+            let named = GarmentKind::parse(name).with_context(|| format!("--cut '{setting}'"))?;
+            if named == *kind {
+                cut.apply(settings)
+                    .with_context(|| format!("--cut '{setting}'"))?;
+            }
+        }
+        Ok(cut)
+    }
 }
 
 /// Runs the thirty drapes with `templates`, writes `png`, and the statistics beside it
@@ -87,25 +105,18 @@ pub fn write_sheet(
         },
         ..RenderOptions::default()
     };
-    let mut cut_note = String::new();
-    if templates.flare > 0.0 {
-        cut_note += &format!(", {} cm flare", templates.flare * 100.0);
-    }
-    if templates.bridge < 1.0 {
-        cut_note += &format!(", bridge {}", templates.bridge);
-    }
+    let cuts = kinds
+        .iter()
+        .map(|k| templates.cut(k))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let cut_note: String = templates.cuts.iter().map(|c| format!(", {c}")).collect();
     let mut sheet = Sheet::new(10).with_title(format!(
         "garnet simulate: 30 drapes, templates with {} cm edges{cut_note}",
         edge * 100.0
     ));
     let mut cases = Vec::new();
-    for kind in &kinds {
-        let cut = CutParams {
-            flare: templates.flare,
-            bridge: templates.bridge,
-            ..CutParams::default_for(kind)
-        };
-        let template = build_template(model, kind, &cut, edge)?;
+    for (kind, cut) in kinds.iter().zip(&cuts) {
+        let template = build_template(model, kind, cut, edge)?;
         let template_body = model.shape(&template.body_phenotype)?;
         for i in 0..10u64 {
             let shape = ShapeArgs {

@@ -281,6 +281,16 @@ fn garment_commands_refuse_bad_input() {
         s(&p("far.garment")),
     ]);
     assert!(err.contains("far from the template body"), "{err}");
+    // The sheet's cuts are checked before any drape is simulated; nothing is written.
+    for (cut, says) in [
+        ("hat:flare=0.03", "unknown garment 'hat'"),
+        ("tshirt:flare=0.5", "flare"),
+        ("tshirt", "KIND:KEY=VALUE"),
+    ] {
+        let err = fails(&["simulate", "--sheet", s(&p("sheet.png")), "--cut", cut]);
+        assert!(err.contains(cut) && err.contains(says), "{cut}: {err}");
+    }
+    assert!(!p("sheet.png").exists());
     std::fs::write(p("bad.garment"), b"not a template").unwrap();
     let err = fails(&["garment", "warp", "--template", s(&p("bad.garment"))]);
     assert!(err.contains("bad.garment"), "{err}");

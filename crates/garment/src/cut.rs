@@ -152,6 +152,50 @@ impl CutParams {
         ]
     }
 
+    /// The parameter at `index` of [`RANGES`] (an index past the end gives the last).
+    pub fn field_mut(&mut self, index: usize) -> &mut f32 {
+        match index {
+            0 => &mut self.body_length,
+            1 => &mut self.sleeve_length,
+            2 => &mut self.ease,
+            3 => &mut self.neckline_depth,
+            4 => &mut self.waist_height,
+            5 => &mut self.leg_length,
+            6 => &mut self.flare,
+            _ => &mut self.bridge,
+        }
+    }
+
+    /// Index in [`RANGES`] of the parameter `name`.
+    pub fn index_of(name: &str) -> Option<usize> {
+        RANGES.iter().position(|(n, _, _)| *n == name)
+    }
+
+    /// The names of every parameter, comma-separated (for messages).
+    pub fn names() -> String {
+        RANGES.map(|r| r.0).join(", ")
+    }
+
+    /// Applies `KEY=VALUE[,KEY=VALUE...]` (names as in [`RANGES`], values in metres or the
+    /// fraction `bridge` takes), then validates the whole cut.
+    pub fn apply(&mut self, settings: &str) -> Result<(), GarmentError> {
+        for item in settings.split(',').filter(|s| !s.trim().is_empty()) {
+            let (key, value) = item
+                .split_once('=')
+                .ok_or_else(|| GarmentError::Parameter(format!("'{item}' is not KEY=VALUE")))?;
+            let index = Self::index_of(key.trim()).ok_or_else(|| {
+                GarmentError::Parameter(format!(
+                    "unknown cut parameter '{key}', expected one of {}",
+                    Self::names()
+                ))
+            })?;
+            *self.field_mut(index) = value.trim().parse().map_err(|_| {
+                GarmentError::Parameter(format!("{key} = '{value}' is not a number"))
+            })?;
+        }
+        self.validate()
+    }
+
     /// Checks every parameter is finite and within [`RANGES`].
     pub fn validate(&self) -> Result<(), GarmentError> {
         for ((name, v), (_, lo, hi)) in self.named().iter().zip(RANGES) {
@@ -191,6 +235,28 @@ mod tests {
             ..CutParams::default_for(&GarmentKind::Tshirt)
         };
         assert!(bad.validate().is_err());
+    }
+
+    #[test]
+    fn settings_apply_by_name_and_bad_ones_are_refused() {
+        for (i, (name, lo, hi)) in RANGES.iter().enumerate() {
+            let mut cut = CutParams::default_for(&GarmentKind::Jeans);
+            let v = 0.5 * (lo + hi);
+            cut.apply(&format!("{name}={v}")).unwrap();
+            assert_eq!(cut.named()[i], (*name, v));
+        }
+        let mut cut = CutParams::default_for(&GarmentKind::Tshirt);
+        cut.apply("flare=0.03, bridge=0").unwrap();
+        assert_eq!((cut.flare, cut.bridge), (0.03, 0.0));
+        for (bad, says) in [
+            ("sleeves=0.2", "unknown cut parameter 'sleeves'"),
+            ("flare", "not KEY=VALUE"),
+            ("flare=wide", "not a number"),
+            ("flare=0.5", "flare"),
+        ] {
+            let err = cut.apply(bad).unwrap_err().to_string();
+            assert!(err.contains(says), "{bad}: {err}");
+        }
     }
 
     #[test]
