@@ -86,8 +86,8 @@ pub struct MakeArgs {
     /// Jeans: hip joint to hem along the leg, metres.
     #[arg(long)]
     pub leg_length: Option<f32>,
-    /// Extra ease at the sleeve cuffs or trouser hems, metres, growing from halfway along
-    /// the limb: straight sleeves and legs.
+    /// Extra ease at the sleeve cuffs or trouser hems, metres, growing from a quarter of the
+    /// way along the limb: straight sleeves and legs.
     #[arg(long)]
     pub flare: Option<f32>,
     /// How much the cloth spans the body's hollows (armpits, gluteal cleft) instead of

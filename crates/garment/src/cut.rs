@@ -76,8 +76,8 @@ pub struct CutParams {
     pub waist_height: f32,
     /// Jeans: from the hip joint along the leg to the hem.
     pub leg_length: f32,
-    /// Extra ease at the limb openings (sleeve cuffs, trouser hems): none up to halfway
-    /// along the sleeve or leg, growing linearly to this at the opening, so the sleeve or
+    /// Extra ease at the limb openings (sleeve cuffs, trouser hems): none up to a quarter of
+    /// the way along the sleeve or leg, growing linearly to this at the opening, so the sleeve or
     /// leg hangs straight instead of following the arm or calf. Absent in files written
     /// before it existed, where it is 0.
     #[serde(default)]
