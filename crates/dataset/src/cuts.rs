@@ -32,15 +32,7 @@ impl GarmentPlan {
         let name = spec.name.clone().unwrap_or_else(|| kind.name().to_string());
         let mut base = CutParams::first_for(&kind);
         for (key, &v) in &spec.cut {
-            let i = CutParams::index_of(key).ok_or_else(|| {
-                (
-                    format!("cut.{key}"),
-                    format!(
-                        "unknown cut parameter, expected one of {}",
-                        CutParams::names()
-                    ),
-                )
-            })?;
+            let i = CutParams::index_of(key).map_err(|e| (format!("cut.{key}"), e.to_string()))?;
             *base.field_mut(i) = v;
         }
         base.validate()
@@ -48,15 +40,7 @@ impl GarmentPlan {
         let mut ranges = Vec::new();
         for (key, &[lo, hi]) in &spec.cut_ranges {
             let field = format!("cut_ranges.{key}");
-            let i = CutParams::index_of(key).ok_or_else(|| {
-                (
-                    field.clone(),
-                    format!(
-                        "unknown cut parameter, expected one of {}",
-                        CutParams::names()
-                    ),
-                )
-            })?;
+            let i = CutParams::index_of(key).map_err(|e| (field.clone(), e.to_string()))?;
             if spec.cut.contains_key(key) {
                 return Err((field, "is also fixed in `cut`".into()));
             }

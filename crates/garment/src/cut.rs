@@ -190,14 +190,17 @@ impl CutParams {
         }
     }
 
-    /// Index in [`RANGES`] of the parameter `name`.
-    pub fn index_of(name: &str) -> Option<usize> {
-        RANGES.iter().position(|(n, _, _)| *n == name)
-    }
-
-    /// The names of every parameter, comma-separated (for messages).
-    pub fn names() -> String {
-        RANGES.map(|r| r.0).join(", ")
+    /// Index in [`RANGES`] of the parameter `name`; the error lists the names.
+    pub fn index_of(name: &str) -> Result<usize, GarmentError> {
+        RANGES
+            .iter()
+            .position(|(n, _, _)| *n == name)
+            .ok_or_else(|| {
+                GarmentError::Parameter(format!(
+                    "unknown cut parameter '{name}', expected one of {}",
+                    RANGES.map(|r| r.0).join(", ")
+                ))
+            })
     }
 
     /// Applies `KEY=VALUE[,KEY=VALUE...]` (names as in [`RANGES`], values in metres or the
@@ -207,12 +210,7 @@ impl CutParams {
             let (key, value) = item
                 .split_once('=')
                 .ok_or_else(|| GarmentError::Parameter(format!("'{item}' is not KEY=VALUE")))?;
-            let index = Self::index_of(key.trim()).ok_or_else(|| {
-                GarmentError::Parameter(format!(
-                    "unknown cut parameter '{key}', expected one of {}",
-                    Self::names()
-                ))
-            })?;
+            let index = Self::index_of(key.trim())?;
             *self.field_mut(index) = value.trim().parse().map_err(|_| {
                 GarmentError::Parameter(format!("{key} = '{value}' is not a number"))
             })?;

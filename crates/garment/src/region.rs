@@ -45,18 +45,6 @@ fn along_chain(p: Vec3, upper: (Vec3, Vec3), lower: (Vec3, Vec3), on_lower: bool
     }
 }
 
-/// Which body vertices a garment of `kind` with `cut` covers on `body` (rest pose).
-pub fn covered_vertices(
-    body: &ShapedBody,
-    kind: &GarmentKind,
-    cut: &CutParams,
-) -> Result<Vec<bool>, GarmentError> {
-    Ok(coverage(body, kind, cut)?
-        .iter()
-        .map(Option::is_some)
-        .collect())
-}
-
 /// For every body vertex (`[V]`): `None` where the garment does not cover it, else how far
 /// along the sleeve or trouser leg it lies as a fraction of the cut's sleeve or leg length
 /// (0 on the torso, 1 at the opening).
@@ -154,12 +142,7 @@ pub fn garment_region(
         .map(|f| f.iter().all(|&i| cover[i as usize].is_some()))
         .collect();
     fill_small_gaps(faces, body.mesh.vertices.len(), &mut in_region)?;
-    let mut region = extract(&body.mesh, &in_region);
-    region.along_limb = region
-        .body_vertex
-        .iter()
-        .map(|&i| cover[i as usize].unwrap_or(0.0))
-        .collect();
+    let region = extract(&body.mesh, &in_region, &cover);
     let loops = geom::adjacency::boundary_loops(region.mesh.vertices.len(), &region.mesh.faces)?;
     if let Some(expected) = kind.openings() {
         if loops.len() != expected {
@@ -213,8 +196,9 @@ fn fill_small_gaps(
     Ok(())
 }
 
-/// The sub-mesh of `mesh` made of the faces flagged in `in_region`, compacted.
-fn extract(mesh: &TriMesh, in_region: &[bool]) -> Region {
+/// The sub-mesh of `mesh` made of the faces flagged in `in_region`, compacted; each vertex
+/// takes its fraction along the limb from `cover` (0 where uncovered: filled gaps).
+fn extract(mesh: &TriMesh, in_region: &[bool], cover: &[Option<f32>]) -> Region {
     let mut map = vec![u32::MAX; mesh.vertices.len()];
     let mut body_vertex = Vec::new();
     let mut faces = Vec::new();
@@ -233,7 +217,10 @@ fn extract(mesh: &TriMesh, in_region: &[bool]) -> Region {
         .collect();
     Region {
         mesh: TriMesh { vertices, faces },
-        along_limb: vec![0.0; body_vertex.len()],
+        along_limb: body_vertex
+            .iter()
+            .map(|&i| cover[i as usize].unwrap_or(0.0))
+            .collect(),
         body_vertex,
     }
 }
