@@ -306,6 +306,43 @@ fn clearance_leaves_the_rest_pose_alone_and_lifts_an_arm_out_of_the_chest() {
     assert!(cleared.rotations[right].angle_between(sunk.rotations[right]) < 1e-5);
 }
 
+/// The clearance measures the body skinned as its options say (it always used DQS before
+/// session 16, whatever the drape's skinning): its counts are those of that body.
+#[test]
+fn clearance_measures_the_body_as_it_is_skinned() {
+    use body::clearance::{buried_vertices, clear_limbs, ClearanceOptions, PROBE};
+    use body::self_contact::vertex_segments;
+    let body = model()
+        .shape(&Phenotype {
+            weight: 1.0,
+            ..Default::default()
+        })
+        .unwrap();
+    let sunk = left_arm_along(&body, Vec3::new(-0.15, -1.0, 0.0));
+    let opts = ClearanceOptions {
+        probe: PROBE,
+        ..Default::default()
+    };
+    let segments = vertex_segments(&body);
+    let direct = |skinning| {
+        let buried = buried_vertices(&body.posed(&sunk, skinning).unwrap()).unwrap();
+        let mut count = [0usize; 8];
+        for (v, _) in buried.iter().enumerate().filter(|(_, &b)| b) {
+            if let Some(s) = (segments[v] as usize).checked_sub(1) {
+                count[s] += 1;
+            }
+        }
+        count
+    };
+    let (lbs, dqs) = (direct(Skinning::Lbs), direct(Skinning::Dqs));
+    assert_ne!(lbs, dqs, "the test pose must bury the limbs differently");
+    for (skinning, want) in [(Skinning::Lbs, lbs), (Skinning::Dqs, dqs)] {
+        let (_, report) =
+            clear_limbs(&body, &sunk, &ClearanceOptions { skinning, ..opts }).unwrap();
+        assert_eq!(report.buried_before, want, "{skinning:?}");
+    }
+}
+
 /// Regression (CMU 02_07 frame 480, the left arm pressed across the chest; T-shirts draped in
 /// it were left 10-21 mm inside the body): the default clearance probe (8 mm) keeps a gap
 /// for the cloth, so the arm turns further out than a 2 mm probe turns it (6 against 3
