@@ -241,15 +241,20 @@ fn cmu_walk_frames_stand_upright_with_feet_on_the_floor_and_arms_at_the_sides() 
     }
 }
 
+/// The default body with phenotype `weight` (0..1, 0.5 average).
+fn body_of_weight(weight: f32) -> body::ShapedBody {
+    model()
+        .shape(&Phenotype {
+            weight,
+            ..Default::default()
+        })
+        .unwrap()
+}
+
 #[test]
 fn self_contact_flags_an_arm_through_the_torso_but_not_the_rest_pose() {
     use body::self_contact::SelfContact;
-    let body = model()
-        .shape(&Phenotype {
-            weight: 0.9,
-            ..Default::default()
-        })
-        .unwrap();
+    let body = body_of_weight(0.9);
     let contact = SelfContact::new(&body);
     assert_eq!(contact.count_intersections(&body.mesh), 0, "rest pose");
     // Swing the left arm (and everything below it) across the chest.
@@ -269,12 +274,7 @@ fn left_arm_along(body: &body::ShapedBody, dir: Vec3) -> Pose {
 #[test]
 fn clearance_leaves_the_rest_pose_alone_and_lifts_an_arm_out_of_the_chest() {
     use body::clearance::{clear_limbs, ClearanceOptions};
-    let body = model()
-        .shape(&Phenotype {
-            weight: 1.0,
-            ..Default::default()
-        })
-        .unwrap();
+    let body = body_of_weight(1.0);
     let opts = ClearanceOptions::default();
     let rest = Pose::identity(body.rig.len());
     let (same, report) = clear_limbs(&body, &rest, &opts).unwrap();
@@ -312,12 +312,7 @@ fn clearance_leaves_the_rest_pose_alone_and_lifts_an_arm_out_of_the_chest() {
 fn clearance_measures_the_body_as_it_is_skinned() {
     use body::clearance::{buried_vertices, clear_limbs, ClearanceOptions, PROBE};
     use body::self_contact::vertex_segments;
-    let body = model()
-        .shape(&Phenotype {
-            weight: 1.0,
-            ..Default::default()
-        })
-        .unwrap();
+    let body = body_of_weight(1.0);
     let sunk = left_arm_along(&body, Vec3::new(-0.15, -1.0, 0.0));
     let opts = ClearanceOptions {
         probe: PROBE,
