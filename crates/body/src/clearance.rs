@@ -201,9 +201,9 @@ impl<'a> Burial<'a> {
 }
 
 /// Corrects `pose` so no limb segment of `body` (posed with `opts.skinning`) sinks into the
-/// body more than in its rest pose (see the module docs). The bone of each buried segment (shoulder,
-/// elbow, hip or knee) turns so that the segment's buried part moves against its own
-/// outward normal there (out of what it is buried in), while that helps; a segment whose
+/// body more than in its rest pose (see the module docs). The bone of each buried segment
+/// (shoulder, elbow, hip or knee) turns so that the segment's buried part moves against its
+/// own outward normal there (out of what it is buried in), while that helps; a segment whose
 /// count stops falling keeps its best angle. Returns the corrected pose and what changed;
 /// a pose with clear limbs comes back unchanged.
 pub fn clear_limbs(
