@@ -247,25 +247,14 @@ fn garment_make_import_warp() {
 fn garment_commands_refuse_bad_input() {
     let dir = tempfile::tempdir().unwrap();
     let p = |name: &str| dir.path().join(name);
-    let err = fails(&[
-        "garment",
-        "make",
-        "tshirt",
-        "--ease",
-        "0.5",
-        "--out",
-        s(&p("t.garment")),
-    ]);
-    assert!(err.contains("ease"), "{err}");
-    let err = fails(&[
-        "garment",
-        "make",
-        "jeans",
-        "--flare=-0.01",
-        "--out",
-        s(&p("t.garment")),
-    ]);
-    assert!(err.contains("flare"), "{err}");
+    let out = p("t.garment");
+    for (kind, setting, name) in [
+        ("tshirt", "--ease=0.5", "ease"),
+        ("jeans", "--flare=-0.01", "flare"),
+    ] {
+        let err = fails(&["garment", "make", kind, setting, "--out", s(&out)]);
+        assert!(err.contains(name), "{err}");
+    }
     assert!(!p("t.garment").exists());
     // A box a metre away from the body is not a garment for it.
     let mut cube = geom::TriMesh::cuboid(glam::Vec3::splat(0.15));
