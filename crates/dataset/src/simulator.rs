@@ -46,6 +46,9 @@ impl SimulatorSpec {
         set(&mut o.explode_speed, self.explode_speed);
         set(&mut o.max_penetration, self.max_penetration);
         o.grade = self.grade.unwrap_or(o.grade);
+        if !self.waistband.unwrap_or(false) {
+            o.waistband = None;
+        }
         // Datasets skin with DQS unless their spec says otherwise (see the field's doc).
         o.skinning = Skinning::Dqs;
         if let Some(s) = &self.skinning {
@@ -120,6 +123,12 @@ mod tests {
         // datasets made before the default became LBS rebuild their bodies with it.
         let plain = SimulatorSpec::default().drape_options().unwrap();
         assert_eq!(plain.skinning, Skinning::Dqs);
+        assert_eq!(plain.waistband, None);
+        let banded = SimulatorSpec {
+            waistband: Some(true),
+            ..Default::default()
+        };
+        assert!(banded.drape_options().unwrap().waistband.is_some());
         assert_eq!(DrapeOptions::default().skinning, Skinning::Lbs);
         let bad = SimulatorSpec {
             density: Some(-1.0),

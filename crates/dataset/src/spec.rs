@@ -248,6 +248,12 @@ pub struct SimulatorSpec {
     pub skinning: Option<String>,
     /// Grade the garment to the target body.
     pub grade: Option<bool>,
+    /// Give a garment with a waistband (the jeans) its elastic band
+    /// (`sim::waistband::Waistband::default`); off when absent, so every dataset made
+    /// before it existed drapes as it did. Left out of the canonical JSON when absent (the
+    /// hashes of earlier specs stay the same).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub waistband: Option<bool>,
 }
 
 /// Optional arrays stored per sample.

@@ -10,6 +10,7 @@ pub mod inflate;
 pub mod region;
 pub mod template;
 pub mod uv;
+pub mod waistband;
 pub mod warp;
 pub mod weights;
 

@@ -5,6 +5,7 @@ use std::sync::OnceLock;
 
 use body::{BodyModel, Phenotype, Pose, Skinning};
 use garment::import::{import_garment, ImportLimits};
+use garment::waistband::waistband;
 use garment::warp::warp;
 use garment::{build_template, CutParams, GarmentKind, GarmentTemplate};
 use geom::bvh::Bvh;
@@ -325,4 +326,26 @@ fn a_cut_without_bridging_follows_the_hollows_with_more_cloth() {
         .filter(|p| bvh.contains(**p))
         .count();
     assert_eq!(inside, 0);
+}
+
+#[test]
+fn the_jeans_waistband_is_the_strip_under_the_waist_and_tops_have_none() {
+    let jeans = &templates()[2];
+    let band = waistband(jeans, 0.04).unwrap().unwrap();
+    let v = &jeans.mesh.vertices;
+    let top = v.iter().map(|p| p.y).fold(f32::MIN, f32::max);
+    let n = band.iter().filter(|&&b| b).count();
+    assert!(n > 0 && n < v.len() / 5, "{n} of {} vertices", v.len());
+    for (p, &b) in v.iter().zip(&band) {
+        // The opening is level within an edge or so.
+        if p.y > top - 0.02 {
+            assert!(b, "a vertex 2 cm under the top is in the band");
+        }
+        if p.y < top - 0.04 - 2.0 * EDGE {
+            assert!(!b, "a vertex far under the band is in it");
+        }
+    }
+    for top in &templates()[..2] {
+        assert_eq!(waistband(top, 0.04).unwrap(), None);
+    }
 }

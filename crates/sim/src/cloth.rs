@@ -93,6 +93,15 @@ impl ClothSim {
     /// non-finite coordinate (naming the vertex), an index out of range or an edge of zero
     /// length.
     pub fn new(rest: &TriMesh, params: &ClothParams) -> Result<Self> {
+        Self::with_stretch_scale(rest, params, &vec![1.0; rest.vertices.len()])
+    }
+
+    /// [`ClothSim::new`] with part of the cloth elastic: `scale` (`[N]`, positive) is each
+    /// vertex's stretch modulus as a fraction of `params.stretch_stiffness`, an edge taking
+    /// the smaller of its ends' (see [`Constraints::with_stretch_scale`]). Edges softer than
+    /// the cloth are elastic: [`ClothSim::strains`] leaves them out and
+    /// [`ClothSim::elastic_strains`] reports them.
+    pub fn with_stretch_scale(rest: &TriMesh, params: &ClothParams, scale: &[f32]) -> Result<Self> {
         params.validate()?;
         check_finite("rest mesh", &rest.vertices)?;
         rest.validate()?;
@@ -100,7 +109,7 @@ impl ClothSim {
             return Err(SimError::InvalidMesh("cloth mesh has no faces".into()));
         }
         let n = rest.vertices.len();
-        let cons = Constraints::new(&rest.vertices, &rest.faces, params)?;
+        let cons = Constraints::with_stretch_scale(&rest.vertices, &rest.faces, params, scale)?;
         let h = params.dt as f64;
         let contact_w = cons
             .mass
@@ -238,10 +247,16 @@ impl ClothSim {
         &self.cons.mass
     }
 
-    /// The edges `[E]` (`a < b`, sorted as [`geom::adjacency::edges`]) whose strains
-    /// [`ClothSim::strains`] reports.
+    /// The edges `[E]` (`a < b`, sorted as [`geom::adjacency::edges`]) of the cloth, elastic
+    /// ones included.
     pub fn edges(&self) -> &[[u32; 2]] {
         &self.cons.pairs[..self.cons.n_stretch]
+    }
+
+    /// `[E]` whether each edge (order of [`ClothSim::edges`]) is elastic: softer than the
+    /// cloth.
+    pub fn elastic_edges(&self) -> Vec<bool> {
+        self.cons.stretch_scale.iter().map(|&s| s < 1.0).collect()
     }
 
     /// The pinned (kinematic) vertices, ascending.
@@ -334,12 +349,30 @@ impl ClothSim {
         self.cons.energy(&x) as f32
     }
 
-    /// Edge strains `[E]` (order of [`ClothSim::edges`]): current length / rest length - 1.
+    /// Strains of the cloth's edges that are not elastic (in the order of
+    /// [`ClothSim::edges`], elastic ones skipped): current length / rest length - 1. All
+    /// `[E]` edges when nothing is elastic.
     pub fn strains(&self) -> Vec<f32> {
-        self.cons.strains(&self.x)
+        self.split_strains(false)
     }
 
-    /// Vertex strains `[N]`: the largest strain of each vertex's edges (0 without edges).
+    /// Strains of the elastic edges (order of [`ClothSim::edges`]), each against its own
+    /// rest length: how far the elastic is stretched.
+    pub fn elastic_strains(&self) -> Vec<f32> {
+        self.split_strains(true)
+    }
+
+    fn split_strains(&self, elastic: bool) -> Vec<f32> {
+        let scale = &self.cons.stretch_scale;
+        let strains = self.cons.strains(&self.x).into_iter().zip(scale);
+        strains
+            .filter(|(_, &s)| (s < 1.0) == elastic)
+            .map(|(e, _)| e)
+            .collect()
+    }
+
+    /// Vertex strains `[N]`: the largest strain of each vertex's cloth edges, elastic ones
+    /// left out (0 without such edges).
     pub fn vertex_strains(&self) -> Vec<f32> {
         self.cons.vertex_strains(&self.x)
     }

@@ -34,6 +34,9 @@ pub struct Constraints {
     pub weight: Vec<f64>,
     /// Number of stretch (edge) constraints at the front of `pairs`.
     pub n_stretch: usize,
+    /// `[n_stretch]` each edge's stretch modulus as a fraction of the cloth's
+    /// ([`ClothParams::stretch_stiffness`]): 1 for the cloth, less for an elastic part.
+    pub stretch_scale: Vec<f32>,
     /// `[N]` vertex masses, kg.
     pub mass: Vec<f64>,
     /// `[N+1]` offsets into `incident`.
@@ -84,7 +87,33 @@ impl Constraints {
     /// the caller) with `params`' stiffnesses and density. A vertex touching no face gets the
     /// mean vertex mass so the system stays positive definite.
     pub fn new(vertices: &[Vec3], faces: &[[u32; 3]], params: &ClothParams) -> Result<Self> {
+        Self::with_stretch_scale(vertices, faces, params, &vec![1.0; vertices.len()])
+    }
+
+    /// [`Constraints::new`] with a stretch modulus that varies over the cloth: `scale` (`[N]`,
+    /// positive) is each vertex's modulus as a fraction of `params.stretch_stiffness`, and an
+    /// edge takes the smaller of its ends' (an elastic band sewn to stiff cloth: the edges
+    /// joining them stretch like the band). Errors on a wrong length or a scale that is not
+    /// positive and finite, naming the vertex.
+    pub fn with_stretch_scale(
+        vertices: &[Vec3],
+        faces: &[[u32; 3]],
+        params: &ClothParams,
+        scale: &[f32],
+    ) -> Result<Self> {
         let n = vertices.len();
+        if scale.len() != n {
+            return Err(SimError::InvalidInput(format!(
+                "{} stretch scales for {n} vertices",
+                scale.len()
+            )));
+        }
+        if let Some(i) = scale.iter().position(|s| !(s.is_finite() && *s > 0.0)) {
+            return Err(SimError::InvalidInput(format!(
+                "stretch scale of vertex {i} must be positive and finite, got {}",
+                scale[i]
+            )));
+        }
         let edges = geom::adjacency::edges(faces);
         let bends = geom::adjacency::two_ring_pairs(n, faces)?;
         let length =
@@ -98,7 +127,14 @@ impl Constraints {
             )));
         }
         let area = vertex_areas(vertices, faces);
+        let stretch_scale: Vec<f32> = edges
+            .iter()
+            .map(|&[i, j]| scale[i as usize].min(scale[j as usize]))
+            .collect();
         let mut edge_w = weights(&edges, &edge_rest, &area, params.stretch_stiffness as f64);
+        for (w, &s) in edge_w.iter_mut().zip(&stretch_scale) {
+            *w *= s as f64;
+        }
         let bend_w = weights(&bends, &bend_rest, &area, params.bend_stiffness as f64);
         let total: f64 = area.iter().sum();
         let mean_mass = params.density as f64 * total / n.max(1) as f64;
@@ -154,6 +190,7 @@ impl Constraints {
             rest,
             weight,
             n_stretch,
+            stretch_scale,
             mass,
             inc_offsets,
             incident,
@@ -189,13 +226,17 @@ impl Constraints {
     }
 
     /// Strain of each vertex `[N]`: the largest strain (length / rest - 1) of its stretch
-    /// edges at positions `x` (`[N]`); 0 for a vertex without edges.
+    /// edges at positions `x` (`[N]`), elastic edges (stretch scale under 1) left out; 0 for
+    /// a vertex without such edges.
     pub fn vertex_strains(&self, x: &[Vec3]) -> Vec<f32> {
         let mut out = vec![0.0f32; self.mass.len()];
-        let edges = self.pairs[..self.n_stretch].iter();
-        for (&[a, b], s) in edges.zip(self.strains(x)) {
+        let strains = self.strains(x);
+        for (c, &[a, b]) in self.pairs[..self.n_stretch].iter().enumerate() {
+            if self.stretch_scale[c] < 1.0 {
+                continue;
+            }
             for v in [a as usize, b as usize] {
-                out[v] = out[v].max(s);
+                out[v] = out[v].max(strains[c]);
             }
         }
         out
@@ -257,6 +298,53 @@ mod tests {
         // Compressed along x: the largest is the unchanged edge along z.
         for s in c.vertex_strains(&scaled(0.9)) {
             assert!(s.abs() < 1e-6, "{s}");
+        }
+    }
+
+    #[test]
+    fn an_edge_takes_the_softer_of_its_ends_stretch_scale() {
+        let m = TriMesh::grid(5, 4, 0.1);
+        let p = ClothParams::default();
+        let plain = Constraints::new(&m.vertices, &m.faces, &p).unwrap();
+        // The first row of vertices is elastic, half as stiff.
+        let scale: Vec<f32> = m
+            .vertices
+            .iter()
+            .map(|v| if v.z < -0.1 { 0.5 } else { 1.0 })
+            .collect();
+        let c = Constraints::with_stretch_scale(&m.vertices, &m.faces, &p, &scale).unwrap();
+        assert_eq!(c.pairs, plain.pairs);
+        let mut elastic = 0;
+        for (k, &[a, b]) in c.pairs.iter().enumerate() {
+            let expected = if k < c.n_stretch {
+                let s = scale[a as usize].min(scale[b as usize]);
+                assert_eq!(c.stretch_scale[k], s);
+                elastic += (s < 1.0) as usize;
+                plain.weight[k] * s as f64
+            } else {
+                plain.weight[k]
+            };
+            assert!((c.weight[k] - expected).abs() < 1e-9 * expected, "{k}");
+        }
+        assert!(elastic > 0 && elastic < c.n_stretch);
+        // Stretched along x, the elastic edges count for no vertex's strain: the elastic
+        // row's vertices have only elastic edges.
+        let x: Vec<Vec3> = m
+            .vertices
+            .iter()
+            .map(|v| Vec3::new(v.x * 1.1, v.y, v.z))
+            .collect();
+        for (s, k) in c.vertex_strains(&x).into_iter().zip(&scale) {
+            let expected = if *k < 1.0 { 0.0 } else { 0.1 };
+            assert!((s - expected).abs() < 1e-5, "{s} for scale {k}");
+        }
+        for bad in [
+            vec![1.0; 3],
+            vec![0.0; scale.len()],
+            vec![f32::NAN; scale.len()],
+        ] {
+            let e = Constraints::with_stretch_scale(&m.vertices, &m.faces, &p, &bad);
+            assert!(matches!(e, Err(SimError::InvalidInput(_))), "{e:?}");
         }
     }
 }

@@ -18,6 +18,7 @@ use geom::TriMesh;
 use glam::{Quat, Vec3};
 
 use crate::stats::{percentile, DrapeStats, SKIN_TOUCH_M};
+use crate::waistband::Waistband;
 use crate::{BodyCollider, ClothParams, ClothSim, SimError};
 
 /// Settings of a drape.
@@ -65,6 +66,10 @@ pub struct DrapeOptions {
     /// cloth cannot lie where a skinned arm overlaps the chest. `None` drapes the pose as
     /// given.
     pub clearance: Option<ClearanceOptions>,
+    /// The garment's waistband, where it has one (the jeans): elastic and cut to less than
+    /// the waist's girth, so that it holds the garment up. `None`: the band is cloth like
+    /// the rest.
+    pub waistband: Option<Waistband>,
 }
 
 impl Default for DrapeOptions {
@@ -82,6 +87,7 @@ impl Default for DrapeOptions {
             skinning: Skinning::Lbs,
             grade: true,
             clearance: Some(ClearanceOptions::default()),
+            waistband: Some(Waistband::default()),
         }
     }
 }
@@ -156,17 +162,24 @@ pub fn drape(
     calm.rotations.iter_mut().for_each(|q| *q = q.normalize());
     let anchors = SurfaceAnchors::new(&template.mesh, &template_body.mesh)
         .map_err(|e| SimError::InvalidInput(e.to_string()))?;
-    let mut sim = if opts.grade {
-        let graded = TriMesh {
-            vertices: anchors.place(&target.mesh),
-            faces: template.mesh.faces.clone(),
-        };
-        let mut sim = ClothSim::new(&graded, &opts.cloth)?;
-        sim.set_positions(&template.mesh.vertices)?;
-        sim
+    let (mut rest, rest_body) = if opts.grade {
+        (anchors.place(&target.mesh), &target.mesh)
     } else {
-        ClothSim::new(&template.mesh, &opts.cloth)?
+        (template.mesh.vertices.clone(), &template_body.mesh)
     };
+    let stretch_scale = match &opts.waistband {
+        Some(band) => band.apply(template, &mut rest, &geom::bvh::Bvh::from_mesh(rest_body)?)?,
+        None => None,
+    };
+    let rest = TriMesh {
+        vertices: rest,
+        faces: template.mesh.faces.clone(),
+    };
+    let mut sim = match stretch_scale {
+        Some(scale) => ClothSim::with_stretch_scale(&rest, &opts.cloth, &scale)?,
+        None => ClothSim::new(&rest, &opts.cloth)?,
+    };
+    sim.set_positions(&template.mesh.vertices)?;
     let mut collider = BodyCollider::new(&template_body.mesh, opts.cloth.thickness)?;
     let mass = cloth_mass(&template.mesh, opts.cloth.density);
     let rms_speed = |sim: &ClothSim| (2.0 * sim.kinetic_energy() / mass).sqrt();
@@ -252,6 +265,7 @@ pub fn drape(
         &collider.penetration_depths(sim.positions()),
         &sim.strains(),
     );
+    stats.elastic_strain_p99 = percentile(&sim.elastic_strains(), 0.99);
     stats.skin_stretch_p90 = percentile(
         &collider.skin_stretch_under(&target.mesh.vertices, sim.positions(), SKIN_TOUCH_M)?,
         0.9,

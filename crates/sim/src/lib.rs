@@ -30,6 +30,7 @@ pub mod shapes;
 pub mod solver;
 pub mod stats;
 pub mod step;
+pub mod waistband;
 
 pub use cloth::{ClothSim, StepInfo, MAX_SPEED};
 pub use collide::BodyCollider;

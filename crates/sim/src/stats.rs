@@ -18,7 +18,9 @@ pub struct DrapeStats {
     pub max_penetration_m: f32,
     /// 99th percentile of the garment vertices' depths inside the body, metres.
     pub p99_penetration_m: f32,
-    /// Median edge strain (length / rest - 1) over the garment's edges.
+    /// Median edge strain (length / rest - 1) over the garment's cloth edges (this and the
+    /// three below leave out elastic edges, which [`DrapeStats::elastic_strain_p99`]
+    /// reports).
     pub strain_p50: f32,
     /// 90th percentile of the edge strain.
     pub strain_p90: f32,
@@ -54,6 +56,12 @@ pub struct DrapeStats {
     /// skin: tops 22.8-38.3% against at most 20.1%, jeans 5.3-15.6% against at most 4.0%.
     #[serde(default)]
     pub skin_stretch_p90: f32,
+    /// 99th percentile of the strain of the garment's elastic edges (its waistband, see
+    /// [`crate::waistband`]) against their own rest lengths: how far the elastic is
+    /// stretched. The strain fields above are over the cloth's other edges. 0 for a
+    /// garment without elastic.
+    #[serde(default)]
+    pub elastic_strain_p99: f32,
 }
 
 /// Distance within which a garment vertex counts as touching the body's skin, metres
@@ -103,6 +111,9 @@ impl DrapeStats {
         ) + &match self.walked_out {
             0 => String::new(),
             n => format!(", {n} walks out of the body"),
+        } + &match self.elastic_strain_p99 {
+            0.0 => String::new(),
+            e => format!(", elastic stretched p99 {:.1}%", e * 100.0),
         }
     }
 }
