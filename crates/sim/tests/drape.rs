@@ -1,8 +1,8 @@
 //! The drape driver on the real body model: the root's yaw is applied exactly, and the
 //! garment ends on the body it was draped on.
 
-use body::{BodyModel, Phenotype, Pose};
-use garment::{build_template, CutParams, GarmentKind};
+use body::{BodyModel, Phenotype, Pose, ShapedBody};
+use garment::{build_template, CutParams, GarmentKind, GarmentTemplate};
 use geom::bvh::Bvh;
 use glam::{Quat, Vec3};
 use sim::drape::{drape, DrapeOptions};
@@ -90,15 +90,13 @@ fn a_turned_body_gets_the_same_drape_turned() {
     );
 }
 
-/// Regression: a heavy body with its arms hanging slightly inward sinks the upper arms
-/// into the chest (skinning); the sleeves caught in that overlap ended 10-30 mm inside the
-/// body. The drape now corrects the pose first (limb clearance) and the shirt stays out.
-#[test]
-fn arms_sunk_into_a_heavy_chest_are_cleared_before_draping() {
+/// A 3 cm template of `kind` cut as `cut`, its template body, and the heaviest body.
+fn on_a_heavy_body(
+    kind: &GarmentKind,
+    cut: CutParams,
+) -> (GarmentTemplate, ShapedBody, ShapedBody) {
     let model = BodyModel::load().expect("body assets");
-    let kind = GarmentKind::Tshirt;
-    // The T-shirt the bug was found with: its close sleeves end inside the chest.
-    let template = build_template(&model, &kind, &CutParams::first_for(&kind), 0.03).unwrap();
+    let template = build_template(&model, kind, &cut, 0.03).unwrap();
     let template_body = model.shape(&template.body_phenotype).unwrap();
     let target = model
         .shape(&Phenotype {
@@ -106,6 +104,17 @@ fn arms_sunk_into_a_heavy_chest_are_cleared_before_draping() {
             ..Default::default()
         })
         .unwrap();
+    (template, template_body, target)
+}
+
+/// Regression: a heavy body with its arms hanging slightly inward sinks the upper arms
+/// into the chest (skinning); the sleeves caught in that overlap ended 10-30 mm inside the
+/// body. The drape now corrects the pose first (limb clearance) and the shirt stays out.
+#[test]
+fn arms_sunk_into_a_heavy_chest_are_cleared_before_draping() {
+    // The T-shirt the bug was found with: its close sleeves end inside the chest.
+    let kind = GarmentKind::Tshirt;
+    let (template, template_body, target) = on_a_heavy_body(&kind, CutParams::first_for(&kind));
     // Both upper arms (and everything below them) hang down and 8 degrees inward.
     let rig = &target.rig;
     let mut world = vec![Quat::IDENTITY; rig.len()];
@@ -221,16 +230,8 @@ fn the_waistband_is_cut_to_a_fraction_of_the_body_girth() {
 /// its strain target.
 #[test]
 fn the_waistband_holds_jeans_up_on_a_heavy_body_bent_forward() {
-    let model = BodyModel::load().expect("body assets");
     let kind = GarmentKind::Jeans;
-    let template = build_template(&model, &kind, &CutParams::default_for(&kind), 0.03).unwrap();
-    let template_body = model.shape(&template.body_phenotype).unwrap();
-    let target = model
-        .shape(&Phenotype {
-            weight: 1.0,
-            ..Default::default()
-        })
-        .unwrap();
+    let (template, template_body, target) = on_a_heavy_body(&kind, CutParams::default_for(&kind));
     let rig = &target.rig;
     let mut world = vec![Quat::IDENTITY; rig.len()];
     rig.swing_limb(
