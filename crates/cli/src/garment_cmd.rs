@@ -94,6 +94,10 @@ pub struct MakeArgs {
     /// following them, 0 to 1 (a fraction of the default bridging smoothing).
     #[arg(long)]
     pub bridge: Option<f32>,
+    /// Jeans: extra ease over the thighs and knees, metres (most 40% of the way down the
+    /// leg, none at the hips and from 75% on).
+    #[arg(long)]
+    pub thigh: Option<f32>,
     /// Template file to write (default out/KIND.garment).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -222,6 +226,7 @@ fn make(model: &BodyModel, args: &MakeArgs) -> anyhow::Result<()> {
         leg_length: args.leg_length.unwrap_or(d.leg_length),
         flare: args.flare.unwrap_or(d.flare),
         bridge: args.bridge.unwrap_or(d.bridge),
+        thigh: args.thigh.unwrap_or(d.thigh),
     };
     let t0 = std::time::Instant::now();
     let template = build_template(model, &kind, &cut, args.edge)?;

@@ -5,6 +5,7 @@ use body::{BodyModel, Phenotype};
 use geom::bvh::Bvh;
 use geom::remesh::{isotropic_remesh, RemeshOptions};
 
+use crate::cut::{THIGH_PEAK, THIGH_SPAN};
 use crate::inflate::{inflate, push_out, InflateOptions};
 use crate::region::garment_region;
 use crate::template::GarmentTemplate;
@@ -37,12 +38,20 @@ pub fn build_template(
     let bvh = Bvh::from_mesh(&body.mesh)?;
     let mut region = garment_region(&body, kind, cut)?;
     let opts = InflateOptions::new(cut.ease, cut.bridge);
-    let flare: Vec<f32> = region
+    let thigh = if *kind == GarmentKind::Jeans {
+        cut.thigh
+    } else {
+        0.0
+    };
+    let extra: Vec<f32> = region
         .along_limb
         .iter()
-        .map(|&t| cut.flare * ((t - FLARE_FROM) / (1.0 - FLARE_FROM)).clamp(0.0, 1.0))
+        .map(|&t| {
+            let flare = cut.flare * ((t - FLARE_FROM) / (1.0 - FLARE_FROM)).clamp(0.0, 1.0);
+            flare + thigh * (1.0 - (t - THIGH_PEAK).abs() / THIGH_SPAN).max(0.0)
+        })
         .collect();
-    inflate(&mut region.mesh, &flare, &bvh, &opts)?;
+    inflate(&mut region.mesh, &extra, &bvh, &opts)?;
     let remeshed = isotropic_remesh(&region.mesh, &RemeshOptions::new(edge))?;
     let mut mesh = remeshed.mesh;
     push_out(&mut mesh.vertices, &bvh, opts.min_gap);

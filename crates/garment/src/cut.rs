@@ -60,8 +60,8 @@ impl GarmentKind {
 }
 
 /// Cut parameters of a garment (metres on the template body). Parameters a kind does
-/// not use are ignored (`sleeve_length` and `neckline_depth` for jeans; `waist_height`
-/// and `leg_length` for tops).
+/// not use are ignored (`sleeve_length` and `neckline_depth` for jeans; `waist_height`,
+/// `leg_length` and `thigh` for tops).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CutParams {
     /// Tops: from the base of the neck down to the hem.
@@ -89,14 +89,27 @@ pub struct CutParams {
     /// files written before it existed, where it is 1.
     #[serde(default = "full_bridge")]
     pub bridge: f32,
+    /// Jeans: extra ease over the thighs and knees (a looser thigh, as "relaxed" and
+    /// "carrot" cuts have): none at the hips, growing to this at [`THIGH_PEAK`] of the way
+    /// along the leg (above the knee), none again at twice that. Absent in files written
+    /// before it existed, where it is 0.
+    #[serde(default)]
+    pub thigh: f32,
 }
+
+/// Where along the trouser leg (a fraction of the cut's leg length) the `thigh` room is
+/// largest; it grows linearly from none at the hips (`THIGH_PEAK - THIGH_SPAN`) and falls
+/// back to none at `THIGH_PEAK + THIGH_SPAN`.
+pub const THIGH_PEAK: f32 = 0.4;
+/// Half the length of the leg (a fraction) over which the `thigh` room spreads.
+pub const THIGH_SPAN: f32 = 0.35;
 
 fn full_bridge() -> f32 {
     1.0
 }
 
 /// Valid range of each parameter, `(name, min, max)`: metres, except `bridge` (a fraction).
-pub const RANGES: [(&str, f32, f32); 8] = [
+pub const RANGES: [(&str, f32, f32); 9] = [
     ("body_length", 0.35, 0.62),
     ("sleeve_length", 0.06, 0.5),
     ("ease", 0.005, 0.06),
@@ -105,6 +118,7 @@ pub const RANGES: [(&str, f32, f32); 8] = [
     ("leg_length", 0.2, 0.8),
     ("flare", 0.0, 0.08),
     ("bridge", 0.0, 1.0),
+    ("thigh", 0.0, 0.06),
 ];
 
 impl CutParams {
@@ -129,6 +143,7 @@ impl CutParams {
                 bridge: 0.0,
                 ease: 0.04,
                 waist_height: 0.10,
+                thigh: 0.03,
                 ..first
             },
             GarmentKind::Custom(_) => first,
@@ -164,10 +179,11 @@ impl CutParams {
         leg_length: 0.75,
         flare: 0.0,
         bridge: 1.0,
+        thigh: 0.0,
     };
 
     /// `(name, value)` of every parameter, in [`RANGES`] order.
-    pub fn named(&self) -> [(&'static str, f32); 8] {
+    pub fn named(&self) -> [(&'static str, f32); 9] {
         [
             ("body_length", self.body_length),
             ("sleeve_length", self.sleeve_length),
@@ -177,6 +193,7 @@ impl CutParams {
             ("leg_length", self.leg_length),
             ("flare", self.flare),
             ("bridge", self.bridge),
+            ("thigh", self.thigh),
         ]
     }
 
@@ -190,7 +207,8 @@ impl CutParams {
             4 => &mut self.waist_height,
             5 => &mut self.leg_length,
             6 => &mut self.flare,
-            _ => &mut self.bridge,
+            7 => &mut self.bridge,
+            _ => &mut self.thigh,
         }
     }
 
@@ -286,16 +304,19 @@ mod tests {
     }
 
     #[test]
-    fn cuts_written_before_flare_and_bridge_read_as_before() {
+    fn cuts_written_before_flare_bridge_and_thigh_read_as_before() {
         let json = r#"{"body_length":0.59,"sleeve_length":0.28,"ease":0.04,
             "neckline_depth":0.04,"waist_height":0.04,"leg_length":0.75}"#;
         let cut: CutParams = serde_json::from_str(json).unwrap();
         assert_eq!(cut, CutParams::first_for(&GarmentKind::Tshirt));
-        assert_eq!((cut.flare, cut.bridge), (0.0, 1.0));
+        assert_eq!((cut.flare, cut.bridge, cut.thigh), (0.0, 1.0, 0.0));
         let tshirt = CutParams::default_for(&GarmentKind::Tshirt);
         assert_eq!((tshirt.flare, tshirt.bridge), (0.03, 0.0));
         let jeans = CutParams::default_for(&GarmentKind::Jeans);
         assert_eq!((jeans.flare, jeans.bridge), (0.0, 0.0));
-        assert_eq!((jeans.ease, jeans.waist_height), (0.04, 0.10));
+        assert_eq!(
+            (jeans.ease, jeans.waist_height, jeans.thigh),
+            (0.04, 0.10, 0.03)
+        );
     }
 }

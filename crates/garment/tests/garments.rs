@@ -303,6 +303,57 @@ fn flare_widens_the_sleeve_and_leg_openings_only() {
 }
 
 #[test]
+fn thigh_room_loosens_the_jeans_thighs_only() {
+    let body = model().shape(&Phenotype::default()).unwrap();
+    let bvh = Bvh::from_mesh(&body.mesh).unwrap();
+    let kind = GarmentKind::Jeans;
+    let cut = CutParams::first_for(&kind);
+    let thigh = 0.03;
+    let plain = build_template(model(), &kind, &cut, EDGE).unwrap();
+    let roomy = build_template(model(), &kind, &CutParams { thigh, ..cut }, EDGE).unwrap();
+    // Mean gap to the skin of the vertices within 3 cm of the height where the room is
+    // largest (the leg hangs nearly straight down in the rest pose).
+    let hip = body.rig.bones[body.rig.index("LeftUpLeg").unwrap()].head;
+    let peak = hip.y - garment::cut::THIGH_PEAK * cut.leg_length;
+    let thigh_gap = |t: &GarmentTemplate| {
+        let gaps: Vec<f32> = (t.mesh.vertices.iter())
+            .filter(|p| (p.y - peak).abs() < 0.03)
+            .map(|&p| bvh.closest_point(p).unwrap().distance)
+            .collect();
+        gaps.iter().sum::<f32>() / gaps.len() as f32
+    };
+    let grown = thigh_gap(&roomy) - thigh_gap(&plain);
+    // Smoothing spreads the room and takes some of it (measured: 1.9 cm of 3).
+    assert!(
+        grown > 0.5 * thigh && grown < 1.2 * thigh,
+        "the thighs grew {grown} m"
+    );
+    // The waist and the hems keep their ease.
+    let before = openings(&plain, &bvh);
+    for (c1, g1) in openings(&roomy, &bvh) {
+        let (c0, g0) = before
+            .iter()
+            .min_by(|a, b| a.0.distance(c1).total_cmp(&b.0.distance(c1)))
+            .unwrap();
+        assert!(
+            c0.distance(c1) < 0.02 && (g1 - g0).abs() < 0.005,
+            "{c0} {g0} -> {c1} {g1}"
+        );
+    }
+    // Tops have no thighs: the setting changes nothing.
+    let tshirt = CutParams::first_for(&GarmentKind::Tshirt);
+    let a = build_template(model(), &GarmentKind::Tshirt, &tshirt, EDGE).unwrap();
+    let b = build_template(
+        model(),
+        &GarmentKind::Tshirt,
+        &CutParams { thigh, ..tshirt },
+        EDGE,
+    )
+    .unwrap();
+    assert_eq!(a.mesh, b.mesh);
+}
+
+#[test]
 fn a_cut_without_bridging_follows_the_hollows_with_more_cloth() {
     let body = model().shape(&Phenotype::default()).unwrap();
     let bvh = Bvh::from_mesh(&body.mesh).unwrap();
