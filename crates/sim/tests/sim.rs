@@ -395,3 +395,53 @@ fn nan_and_blow_up_are_errors() {
     );
     assert_eq!(sim.positions(), &cloth.vertices[..], "state kept");
 }
+
+/// A hanging cloth with a soft strip across it (as a waistband is): the strip stretches
+/// more than the cloth around it, and the statistics keep the two apart.
+#[test]
+fn an_elastic_strip_stretches_more_and_is_reported_apart() {
+    // A 20 cm square hanging in the x-y plane from its top row.
+    let grid = TriMesh::grid(11, 11, 0.02);
+    let cloth = TriMesh {
+        vertices: grid
+            .vertices
+            .iter()
+            .map(|v| Vec3::new(v.x, -v.z, 0.0))
+            .collect(),
+        faces: grid.faces.clone(),
+    };
+    let top = cloth.vertices.iter().map(|v| v.y).fold(f32::MIN, f32::max);
+    let strip = |v: &Vec3| v.y.abs() < 0.03;
+    let scale: Vec<f32> = (cloth.vertices.iter())
+        .map(|v| if strip(v) { 0.05 } else { 1.0 })
+        .collect();
+    let params = ClothParams::default();
+    let mut sim = ClothSim::with_stretch_scale(&cloth, &params, &scale).unwrap();
+    let pins: Vec<u32> = (0..cloth.vertices.len() as u32)
+        .filter(|&i| cloth.vertices[i as usize].y > top - 1e-4)
+        .collect();
+    sim.set_pinned(&pins).unwrap();
+    for _ in 0..240 {
+        sim.step(None).unwrap();
+    }
+    let elastic = sim.elastic_edges();
+    let n_elastic = elastic.iter().filter(|&&e| e).count();
+    let (cloth_strains, band_strains) = (sim.strains(), sim.elastic_strains());
+    assert!(n_elastic > 0 && n_elastic < elastic.len());
+    assert_eq!(band_strains.len(), n_elastic);
+    assert_eq!(cloth_strains.len() + n_elastic, sim.edges().len());
+    let max = |s: &[f32]| s.iter().copied().fold(f32::MIN, f32::max);
+    assert!(
+        max(&band_strains) > 5.0 * max(&cloth_strains),
+        "strip {} cloth {}",
+        max(&band_strains),
+        max(&cloth_strains)
+    );
+    assert!(max(&cloth_strains) < 0.02, "{}", max(&cloth_strains));
+    // A vertex's strain is that of its cloth edges only: inside the strip it is 0.
+    for (s, v) in sim.vertex_strains().iter().zip(&cloth.vertices) {
+        if v.y.abs() < 0.005 {
+            assert_eq!(*s, 0.0);
+        }
+    }
+}
