@@ -368,6 +368,46 @@ fn simulate_skins_with_linear_blending_so_raised_shoulders_fit_the_armholes() {
     assert!(walk.0 < lbs.0, "walk {walk:?}, yoga {lbs:?}");
 }
 
+/// Jeans get the elastic waistband by default: its stretch is reported apart from the
+/// cloth's. A settings file drapes as a dataset spec does, without the band unless it asks
+/// for one (`waistband = true`).
+#[test]
+fn simulate_gives_jeans_an_elastic_waistband_unless_a_settings_file_leaves_it_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let template = dir.path().join("j.garment");
+    ok(&[
+        "garment",
+        "make",
+        "jeans",
+        "--edge",
+        "0.03",
+        "--out",
+        s(&template),
+    ]);
+    let band = |file: Option<&str>| {
+        let mut flags = vec!["--max-settle-steps", "30"];
+        let settings = dir.path().join("sim.toml");
+        if let Some(text) = file {
+            std::fs::write(&settings, text).unwrap();
+            flags.extend(["--simulator", s(&settings)]);
+        }
+        let st = simulate_stats(&template, &flags);
+        (
+            st["elastic_strain_p99"].as_f64().unwrap(),
+            st["strain_p99"].as_f64().unwrap(),
+        )
+    };
+    let (default, plain, asked) = (
+        band(None),
+        band(Some("skinning = \"lbs\"\n")),
+        band(Some("skinning = \"lbs\"\nwaistband = true\n")),
+    );
+    // Cut to 90% of the waist's girth, the band is stretched by 11% or more.
+    assert!(default.0 > 0.1, "{default:?}");
+    assert_eq!(asked, default);
+    assert_eq!(plain.0, 0.0);
+}
+
 /// `--simulator` reads a spec's `[simulator]` keys (bare or under the header, beside other
 /// tables), the flags override them, and a bad file is refused naming the file and the key.
 #[test]
