@@ -285,18 +285,10 @@ fn garment_commands_refuse_bad_input() {
     assert!(err.contains("bad.garment"), "{err}");
 }
 
-/// A T-shirt template with `edge`-metre edges written into `dir`.
-fn tshirt_template(dir: &std::path::Path, edge: &str) -> PathBuf {
-    let path = dir.join("t.garment");
-    ok(&[
-        "garment",
-        "make",
-        "tshirt",
-        "--edge",
-        edge,
-        "--out",
-        s(&path),
-    ]);
+/// A template of `kind` (tshirt, sweater, jeans) with `edge`-metre edges written into `dir`.
+fn template(dir: &std::path::Path, kind: &str, edge: &str) -> PathBuf {
+    let path = dir.join(format!("{kind}.garment"));
+    ok(&["garment", "make", kind, "--edge", edge, "--out", s(&path)]);
     path
 }
 
@@ -325,7 +317,7 @@ fn simulate_stats(template: &std::path::Path, flags: &[&str]) -> serde_json::Val
 #[test]
 fn simulate_skins_with_linear_blending_so_raised_shoulders_fit_the_armholes() {
     let dir = tempfile::tempdir().unwrap();
-    let template = tshirt_template(dir.path(), "0.04");
+    let template = template(dir.path(), "tshirt", "0.04");
     let yoga = [
         "--random-shape",
         "103",
@@ -374,16 +366,7 @@ fn simulate_skins_with_linear_blending_so_raised_shoulders_fit_the_armholes() {
 #[test]
 fn simulate_gives_jeans_an_elastic_waistband_unless_a_settings_file_leaves_it_out() {
     let dir = tempfile::tempdir().unwrap();
-    let template = dir.path().join("j.garment");
-    ok(&[
-        "garment",
-        "make",
-        "jeans",
-        "--edge",
-        "0.03",
-        "--out",
-        s(&template),
-    ]);
+    let template = template(dir.path(), "jeans", "0.03");
     let band = |file: Option<&str>| {
         let mut flags = vec!["--max-settle-steps", "30"];
         let settings = dir.path().join("sim.toml");
@@ -414,7 +397,7 @@ fn simulate_gives_jeans_an_elastic_waistband_unless_a_settings_file_leaves_it_ou
 fn simulate_takes_simulator_settings_from_a_file() {
     let dir = tempfile::tempdir().unwrap();
     let p = |name: &str| dir.path().join(name);
-    let template = tshirt_template(dir.path(), "0.04");
+    let template = template(dir.path(), "tshirt", "0.04");
     let settle = |file: &str, text: &str, flags: &[&str]| {
         std::fs::write(p(file), text).unwrap();
         let settings = p(file);
