@@ -90,9 +90,9 @@ pub struct CutParams {
     #[serde(default = "full_bridge")]
     pub bridge: f32,
     /// Jeans: extra ease over the thighs and knees (a looser thigh, as "relaxed" and
-    /// "carrot" cuts have): none at the hips, growing to this at [`THIGH_PEAK`] of the way
-    /// along the leg (above the knee), none again at twice that. Absent in files written
-    /// before it existed, where it is 0.
+    /// "carrot" cuts have): none at the hips, growing to this [`THIGH_PEAK`] of the way
+    /// down the leg (above the knee), none again from `THIGH_PEAK + THIGH_SPAN` (75%) on.
+    /// Absent in files written before it existed, where it is 0.
     #[serde(default)]
     pub thigh: f32,
 }
@@ -124,13 +124,14 @@ pub const RANGES: [(&str, f32, f32); 9] = [
 impl CutParams {
     /// The default cut of a kind: a regular T-shirt and a loose long sweater, both with
     /// straight sleeves (`flare` 3 cm) and cloth that follows the armpit fold (`bridge` 0),
-    /// so that they fit arms raised overhead; relaxed jeans (4 cm of ease) up to the
-    /// natural waist (`waist_height` 0.10, where the body is narrower than the hips, so the
-    /// simulator's elastic waistband holds them up), following the body's hollows (`bridge`
-    /// 0: more cloth behind the knees and in the seat). Measured on the 30-drape sheet at 1
-    /// cm: session 15, 26 drapes at rest under 2% strain p99 (every top, 6 of 10 jeans),
-    /// against 21 with the [`first_for`](Self::first_for) cut; session 17, with the
-    /// waistband, 9 of 10 jeans (7 with `bridge` 0.5, 7 with 3 cm of ease).
+    /// so that they fit arms raised overhead; relaxed, tapered jeans (4 cm of ease and 3 cm
+    /// more over the thighs and knees) up to the natural waist (`waist_height` 0.10, where
+    /// the body is narrower than the hips, so the simulator's elastic waistband holds them
+    /// up), following the body's hollows (`bridge` 0: more cloth behind the knees and in the
+    /// seat). Measured on the 30-drape sheet at 1 cm: session 15, 26 drapes at rest under 2%
+    /// strain p99 (every top, 6 of 10 jeans), against 21 with the
+    /// [`first_for`](Self::first_for) cut; session 17, with the waistband, all 30 (without
+    /// the thigh room 9 of 10 jeans, with `bridge` 0.5 7).
     pub fn default_for(kind: &GarmentKind) -> Self {
         let first = Self::first_for(kind);
         match kind {

@@ -30,7 +30,7 @@ impl Default for Waistband {
     /// A 4 cm band cut to 90% of the body's girth, 0.3 times as stiff as the cloth.
     /// Measured on the 30-drape sheet's ten jeans at 1 cm (session 17, jeans cut with
     /// `waist_height 0.10`, 2-4 cm ease): a band a tenth as stiff let the looser jeans
-    /// slide (ease 4 cm: 3 of 10 still sliding after 400 settling steps, against none at
+    /// slide (ease 4 cm: 2 of 10 still sliding after 400 settling steps, against none at
     /// 0.2 and 0.3); cut to 85% of the girth it held as well, but pressed the skin's
     /// facets through the cloth between its vertices.
     fn default() -> Self {
