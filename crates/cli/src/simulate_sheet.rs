@@ -203,14 +203,19 @@ fn short(what: &str) -> String {
 /// A Markdown table of the cases and a summary line.
 fn markdown(cases: &[Case]) -> String {
     let mut out = String::from(
-        "| garment | shape | pose | time (s) | steps | at rest | max pen. (mm) | strain p99 (%) | skin stretch p90 (%) | slid (cm) | limbs turned (deg) | walked out |\n|---|---|---|---:|---:|---|---:|---:|---:|---:|---:|---:|\n",
+        "| garment | shape | pose | time (s) | steps | at rest | max pen. (mm) | strain p99 (%) | elastic p99 (%) | skin stretch p90 (%) | slid (cm) | limbs turned (deg) | walked out |\n|---|---|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     for c in cases {
         match &c.stats {
             Some(s) => {
+                // The waistband's stretch; none for a garment without elastic.
+                let elastic = match s.elastic_strain_p99 {
+                    0.0 => "-".to_string(),
+                    e => format!("{:.1}", e * 100.0),
+                };
                 out += &format!(
                     concat!(
-                        "| {} | {} | {} | {:.2} | {} | {} | {:.2} | {:.2} | {:.1} | {:.1} | ",
+                        "| {} | {} | {} | {:.2} | {} | {} | {:.2} | {:.2} | {} | {:.1} | {:.1} | ",
                         "{:.0} | {} |\n"
                     ),
                     c.garment,
@@ -221,6 +226,7 @@ fn markdown(cases: &[Case]) -> String {
                     if s.converged { "yes" } else { "no" },
                     s.max_penetration_m * 1e3,
                     s.strain_p99 * 100.0,
+                    elastic,
                     s.skin_stretch_p90 * 100.0,
                     s.slid_m * 100.0,
                     s.limb_turn_deg,
@@ -229,7 +235,7 @@ fn markdown(cases: &[Case]) -> String {
             }
             None => {
                 out += &format!(
-                    "| {} | {} | {} | failed: {} | | | | | | | | |\n",
+                    "| {} | {} | {} | failed: {} | | | | | | | | | |\n",
                     c.garment,
                     c.shape_seed,
                     c.pose,
