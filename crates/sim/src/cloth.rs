@@ -256,7 +256,9 @@ impl ClothSim {
     /// `[E]` whether each edge (order of [`ClothSim::edges`]) is elastic: softer than the
     /// cloth.
     pub fn elastic_edges(&self) -> Vec<bool> {
-        self.cons.stretch_scale.iter().map(|&s| s < 1.0).collect()
+        (0..self.cons.n_stretch)
+            .map(|c| self.cons.is_elastic(c))
+            .collect()
     }
 
     /// The pinned (kinematic) vertices, ascending.
@@ -363,11 +365,10 @@ impl ClothSim {
     }
 
     fn split_strains(&self, elastic: bool) -> Vec<f32> {
-        let scale = &self.cons.stretch_scale;
-        let strains = self.cons.strains(&self.x).into_iter().zip(scale);
+        let strains = self.cons.strains(&self.x).into_iter().enumerate();
         strains
-            .filter(|(_, &s)| (s < 1.0) == elastic)
-            .map(|(e, _)| e)
+            .filter(|&(c, _)| self.cons.is_elastic(c) == elastic)
+            .map(|(_, e)| e)
             .collect()
     }
 

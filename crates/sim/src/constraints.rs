@@ -197,6 +197,12 @@ impl Constraints {
         })
     }
 
+    /// Whether stretch edge `c` (`< n_stretch`) is elastic: softer than the cloth.
+    #[inline]
+    pub fn is_elastic(&self, c: usize) -> bool {
+        self.stretch_scale[c] < 1.0
+    }
+
     /// The constraints at vertex `i` (each seen from `i`).
     #[inline]
     pub fn at(&self, i: usize) -> &[Incident] {
@@ -232,7 +238,7 @@ impl Constraints {
         let mut out = vec![0.0f32; self.mass.len()];
         let strains = self.strains(x);
         for (c, &[a, b]) in self.pairs[..self.n_stretch].iter().enumerate() {
-            if self.stretch_scale[c] < 1.0 {
+            if self.is_elastic(c) {
                 continue;
             }
             for v in [a as usize, b as usize] {

@@ -168,17 +168,15 @@ pub fn drape(
         (template.mesh.vertices.clone(), &template_body.mesh)
     };
     let stretch_scale = match &opts.waistband {
-        Some(band) => band.apply(template, &mut rest, &geom::bvh::Bvh::from_mesh(rest_body)?)?,
+        Some(band) => band.apply(template, &mut rest, rest_body)?,
         None => None,
-    };
+    }
+    .unwrap_or_else(|| vec![1.0; rest.len()]);
     let rest = TriMesh {
         vertices: rest,
         faces: template.mesh.faces.clone(),
     };
-    let mut sim = match stretch_scale {
-        Some(scale) => ClothSim::with_stretch_scale(&rest, &opts.cloth, &scale)?,
-        None => ClothSim::new(&rest, &opts.cloth)?,
-    };
+    let mut sim = ClothSim::with_stretch_scale(&rest, &opts.cloth, &stretch_scale)?;
     sim.set_positions(&template.mesh.vertices)?;
     let mut collider = BodyCollider::new(&template_body.mesh, opts.cloth.thickness)?;
     let mass = cloth_mass(&template.mesh, opts.cloth.density);

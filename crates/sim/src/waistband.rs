@@ -6,6 +6,7 @@
 use garment::waistband::waistband;
 use garment::GarmentTemplate;
 use geom::bvh::Bvh;
+use geom::TriMesh;
 use glam::Vec3;
 
 use crate::SimError;
@@ -55,7 +56,7 @@ impl Waistband {
         &self,
         template: &GarmentTemplate,
         rest: &mut [Vec3],
-        body: &Bvh,
+        body: &TriMesh,
     ) -> Result<Option<Vec<f32>>, SimError> {
         let fraction = |name: &str, v: f32| {
             if v.is_finite() && v > 0.0 && v <= 1.0 {
@@ -79,11 +80,13 @@ impl Waistband {
         else {
             return Ok(None);
         };
+        // The skin is searched only for a garment that has a band.
+        let bvh = Bvh::from_mesh(body)?;
         let inside = || rest.iter().zip(&band).filter(|(_, &b)| b).map(|(p, _)| *p);
         let count = inside().count().max(1) as f32;
         let centre = inside().sum::<Vec3>() / count;
         for (p, _) in rest.iter_mut().zip(&band).filter(|(_, &b)| b) {
-            let skin = body.closest_point(*p).map_or(*p, |hit| hit.point);
+            let skin = bvh.closest_point(*p).map_or(*p, |hit| hit.point);
             p.x = centre.x + (skin.x - centre.x) * self.girth;
             p.z = centre.z + (skin.z - centre.z) * self.girth;
         }
