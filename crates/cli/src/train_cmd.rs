@@ -2,7 +2,7 @@
 //! each epoch, best and last checkpoints, `--resume`, a progress bar with the loss terms
 //! and a metrics log (`metrics.csv`).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 use burn::module::Module;
@@ -82,6 +82,11 @@ pub struct TrainArgs {
     /// the 13380, 2 the paper's ~6.9k). A new run only: a resumed run keeps its network.
     #[arg(long, value_name = "N")]
     pub body_subsample: Option<usize>,
+    /// The network's widths as a JSON file of `GarNetConfig` fields (any left out take their
+    /// defaults; `--variant` and `--body-subsample` override the file). A new run only: a
+    /// resumed run keeps its network.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
     /// Seed of the per-epoch shuffle.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -187,6 +192,40 @@ impl<'a> GarmentSplit<'a> {
     }
 }
 
+/// Reads a `--config` file: a JSON object of [`GarNetConfig`] fields over the defaults of
+/// `variant`, whose variant it takes.
+fn network_config(path: &Path, variant: Variant) -> anyhow::Result<GarNetConfig> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("reading the network config {}", path.display()))?;
+    let mut fields: serde_json::Map<String, serde_json::Value> = serde_json::from_str(&text)
+        .with_context(|| format!("{}: not a JSON object of config fields", path.display()))?;
+    let defaults = serde_json::to_value(GarNetConfig::new(variant))?;
+    let serde_json::Value::Object(defaults) = defaults else {
+        bail!("GarNetConfig does not serialise to an object");
+    };
+    if let Some(unknown) = fields.keys().find(|k| !defaults.contains_key(*k)) {
+        bail!(
+            "{}: unknown network config field {unknown:?} (known: {})",
+            path.display(),
+            defaults.keys().cloned().collect::<Vec<_>>().join(", ")
+        );
+    }
+    let mut merged = defaults;
+    merged.append(&mut fields);
+    let mut config: GarNetConfig = serde_json::from_value(serde_json::Value::Object(merged))
+        .with_context(|| {
+            format!(
+                "{}: a network config field has the wrong type",
+                path.display()
+            )
+        })?;
+    config.variant = variant;
+    config
+        .validate()
+        .with_context(|| format!("network config {}", path.display()))?;
+    Ok(config)
+}
+
 /// Runs `garnet train`.
 pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
     let data = Dataset::open(&args.data)?;
@@ -220,7 +259,10 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
         }
         let template = train.template()?;
         let garment_file = template.to_bytes(&args.data)?;
-        let mut config = GarNetConfig::new(variant);
+        let mut config = match &args.config {
+            Some(path) => network_config(path, variant)?,
+            None => GarNetConfig::new(variant),
+        };
         if let Some(n) = args.body_subsample {
             config.body_subsample = n;
         }

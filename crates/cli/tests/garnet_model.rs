@@ -411,6 +411,58 @@ fn drape_and_eval_refuse_what_does_not_fit() {
     assert!(!tmp.path().join("x-tshirt.obj").exists());
 }
 
+#[test]
+fn train_takes_the_network_widths_from_a_config_file() {
+    let data = dataset();
+    let tmp = tempfile::tempdir().unwrap();
+    let params = |log: &str| -> usize {
+        let after = log
+            .split("training GarNet-naive (")
+            .nth(1)
+            .expect("the run's header");
+        after.split(' ').next().unwrap().parse().unwrap()
+    };
+    let run = |name: &str, extra: &[&str]| {
+        let out = tmp.path().join(name);
+        let mut a = train_args(data, "naive", "1", &out, extra);
+        a.extend_from_slice(&["--max-samples", "2"]);
+        owned(&a)
+    };
+    let default = params(&ok(&as_str(&run("default", &[]))));
+    let config = tmp.path().join("narrow.json");
+    std::fs::write(&config, r#"{"fusion": [16, 8], "variant": "Local"}"#).unwrap();
+    let log = ok(&as_str(&run("narrow", &["--config", s(&config)])));
+    // The file's fusion widths, the command line's variant: fewer parameters than the
+    // default Naive, still a Naive network.
+    assert!(params(&log) < default, "{log}");
+    let naive = tmp.path().join("narrow/best.garnet");
+    ok(&[
+        "eval",
+        "--data",
+        s(data),
+        "--model",
+        s(&naive),
+        "--max-samples",
+        "1",
+    ]);
+    // An unknown field or a wrong type names the file and the field.
+    std::fs::write(&config, r#"{"fusion_widths": [16]}"#).unwrap();
+    let err = fails(&as_str(&run("bad", &["--config", s(&config)])));
+    assert!(
+        err.contains("narrow.json") && err.contains("fusion_widths") && err.contains("fusion"),
+        "{err}"
+    );
+    std::fs::write(&config, r#"{"fusion": 16}"#).unwrap();
+    let err = fails(&as_str(&run("bad", &["--config", s(&config)])));
+    assert!(err.contains("narrow.json") && err.contains("type"), "{err}");
+    std::fs::write(&config, r#"{"fusion": []}"#).unwrap();
+    let err = fails(&as_str(&run("bad", &["--config", s(&config)])));
+    assert!(
+        err.contains("narrow.json") && err.contains("fusion"),
+        "{err}"
+    );
+}
+
 /// `v` as the `&str` arguments [`ok`] takes.
 /// `garnet train` on `data`'s T-shirts with `variant` for `epochs` into `out`, then `extra`.
 fn train_args<'a>(
