@@ -444,6 +444,8 @@ fn train_takes_the_network_widths_from_a_config_file() {
         s(&naive),
         "--max-samples",
         "1",
+        "--out",
+        s(&tmp.path().join("eval")),
     ]);
     // An unknown field or a wrong type names the file and the field.
     std::fs::write(&config, r#"{"fusion_widths": [16]}"#).unwrap();
