@@ -4,6 +4,7 @@ mod assets_cmd;
 mod bench_cmd;
 mod bench_model;
 mod body_cmd;
+mod compare_cmd;
 mod dataset_cmd;
 mod dataset_show;
 mod drape_cmd;
@@ -62,6 +63,8 @@ enum Cmd {
     Train(train_cmd::TrainArgs),
     /// Export a training checkpoint as a model to ship, with its model card.
     Export(export_cmd::ExportArgs),
+    /// The paper's errors (E_dist, E_norm) between two drapes of one garment mesh.
+    Compare(compare_cmd::CompareArgs),
     /// Benchmarks measured in one run, reported with ratios to a reference.
     #[command(subcommand)]
     Bench(bench_cmd::BenchCmd),
@@ -80,6 +83,7 @@ fn main() {
         Some(Cmd::Drape(a)) => drape_cmd::run(a),
         Some(Cmd::Eval(a)) => eval_cmd::run(a),
         Some(Cmd::Export(a)) => export_cmd::run(a),
+        Some(Cmd::Compare(a)) => compare_cmd::run(a),
         Some(Cmd::Train(a)) => train_cmd::run(a),
         Some(Cmd::Bench(c)) => bench_cmd::run(c),
     };

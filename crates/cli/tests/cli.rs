@@ -495,3 +495,52 @@ fn simulate_drapes_a_template_and_reports_statistics() {
     assert!(err.contains("--template"), "{err}");
     assert!(!p("x.obj").exists());
 }
+
+#[test]
+fn compare_measures_two_drapes_of_one_mesh_and_refuses_other_meshes() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |name: &str| dir.path().join(name);
+    let t = template(dir.path(), "tshirt", "0.04");
+    let warp = |out: &std::path::Path, extra: &[&str]| {
+        let mut args = vec![
+            "garment",
+            "warp",
+            "--template",
+            s(&t),
+            "--tpose",
+            "--out",
+            s(out),
+        ];
+        args.extend_from_slice(extra);
+        ok(&args);
+    };
+    let (a, b) = (p("a.obj"), p("b.ply"));
+    warp(&a, &["--body-out", s(&p("body.obj"))]);
+    warp(&b, &["--weight", "0.9"]);
+    let out = ok(&["compare", s(&a), s(&b), "--json", s(&p("c.json"))]);
+    assert!(out.contains("E_dist"), "{out}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(p("c.json")).unwrap()).unwrap();
+    // The plain metric on the two files read back.
+    let (ma, mb) = (
+        geom::io::read_mesh(&a).unwrap(),
+        geom::io::read_mesh(&b).unwrap(),
+    );
+    let expected = geom::metrics::e_dist(&ma.vertices, &mb.vertices).unwrap() * 100.0;
+    let got = json["e_dist_cm"].as_f64().unwrap() as f32;
+    assert!(
+        expected > 0.1 && (got - expected).abs() < 1e-4,
+        "{got} vs {expected}"
+    );
+    assert_eq!(json["vertices"], ma.vertices.len());
+    assert!(json["dist_max_cm"].as_f64().unwrap() >= json["dist_p90_cm"].as_f64().unwrap());
+    let same = ok(&["compare", s(&a), s(&a)]);
+    assert!(same.contains("E_dist 0.00 cm"), "{same}");
+    let err = fails(&["compare", s(&a), s(&p("body.obj"))]);
+    assert!(
+        err.contains("not the same garment mesh") && err.contains("body.obj"),
+        "{err}"
+    );
+    let err = fails(&["compare", s(&a), s(&p("missing.obj"))]);
+    assert!(err.contains("missing.obj"), "{err}");
+}
