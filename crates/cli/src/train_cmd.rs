@@ -268,7 +268,8 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
         }
         let setup = ModelSetup::new(config, template.mesh.clone(), &train.reference_body()?)?
             .with_garment_file(garment_file)
-            .with_body_skinning(data.body_skinning().name())?;
+            .with_body_skinning(data.body_skinning().name())?
+            .with_body_faces(train.topology.faces.clone())?;
         Trainer::new(setup, loss_config(args), args.lr, &device)?
     };
     if args.grad_clip.is_some() {

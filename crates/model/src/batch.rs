@@ -6,11 +6,13 @@ use std::sync::Arc;
 use burn::prelude::*;
 use glam::Vec3;
 
+use crate::contact::{contact_features, CONTACT_WIDTH};
 use crate::error::{check_count, check_finite, ModelError, Result};
 use crate::frame::CanonicalFrame;
 use crate::local::{BodySampling, LocalIndices};
 use crate::tensors::{points_tensor, vec_tensor};
 use crate::topology::GarmentTopology;
+use crate::vertex_frames::VertexFrames;
 
 /// The body mesh connectivity shared by the samples of a dataset (all bodies have one
 /// topology): faces and unique edges, for the body normals and mean edge length that the
@@ -108,6 +110,12 @@ pub struct InputSpec {
     /// The template's rest vertices `[N]` (metres) that each sample's canonical frame is
     /// fitted to (see [`crate::frame`]); `None` keeps world coordinates.
     pub canonical_rest: Option<Vec<Vec3>>,
+    /// The body faces `[F]` when the network takes body-contact features (see
+    /// [`crate::contact`]; the faces give the body normals).
+    pub contact_faces: Option<Vec<[u32; 3]>>,
+    /// The garment's vertex frames when the network predicts in them (see
+    /// [`crate::vertex_frames`]).
+    pub vertex_frames: Option<VertexFrames>,
 }
 
 impl InputSpec {
@@ -141,13 +149,14 @@ impl InputSpec {
     }
 
     /// The network inputs of B samples: stream points `[B][P]` of `bodies` `[B][V]`, and the
-    /// local tables of them and `warped` `[B][N]` when the spec has them.
+    /// local tables and the contact features `[B,N,CONTACT_WIDTH]` of them and `warped`
+    /// `[B][N]` (metres, one frame) when the spec has them.
     pub fn inputs(
         &self,
         bodies: &[&[Vec3]],
         warped: &[&[Vec3]],
         device: &Device,
-    ) -> Result<(Tensor<3>, Option<LocalIndices>)> {
+    ) -> Result<NetInputs> {
         let streams = bodies
             .iter()
             .map(|b| self.sampling.stream_points(b))
@@ -164,8 +173,53 @@ impl InputSpec {
             )?),
             None => None,
         };
-        Ok((points_tensor(&refs, device), local))
+        let contact = match &self.contact_faces {
+            Some(faces) => {
+                let mut flat = Vec::new();
+                for (body, m) in bodies.iter().zip(warped) {
+                    geom::adjacency::check_indices(body.len(), faces)?;
+                    let normals = geom::normals::vertex_normals(body, faces);
+                    let index = geom::KnnIndex::new(body)?;
+                    flat.extend(contact_features(&index, body, &normals, m)?);
+                }
+                let n = warped.first().map_or(0, |m| m.len());
+                Some(vec_tensor(flat, [warped.len(), n, CONTACT_WIDTH], device))
+            }
+            None => None,
+        };
+        let rotations = match &self.vertex_frames {
+            Some(frames) => {
+                let mut flat = Vec::new();
+                for m in warped {
+                    flat.extend(frames.rotations(m)?);
+                }
+                let n = warped.first().map_or(0, |m| m.len());
+                Some(vec_tensor(flat, [warped.len(), n, 9], device))
+            }
+            None => None,
+        };
+        Ok(NetInputs {
+            body_stream: points_tensor(&refs, device),
+            local,
+            contact,
+            rotations,
+        })
     }
+}
+
+/// What [`InputSpec::inputs`] makes of B samples besides M: the network's inputs (see
+/// [`crate::GarNet::translations`]).
+#[derive(Clone, Debug)]
+pub struct NetInputs {
+    /// The body points the body stream sees `[B,P,3]`, metres.
+    pub body_stream: Tensor<3>,
+    /// GarNet-Local's neighbour tables.
+    pub local: Option<LocalIndices>,
+    /// Body-contact features `[B,N,CONTACT_WIDTH]` (see [`crate::contact`]).
+    pub contact: Option<Tensor<3>>,
+    /// Rotations `[B,N,9]` from the template's vertex frames to M's, row-major (see
+    /// [`crate::vertex_frames`]).
+    pub rotations: Option<Tensor<3>>,
 }
 
 /// A batch of B samples as tensors on one device, sharing one garment topology.
@@ -177,8 +231,9 @@ pub struct Batch {
     pub n_body: usize,
     /// Garment vertices per sample N.
     pub n_garment: usize,
-    /// The body points the body stream sees `[B,P,3]`, metres.
-    pub body_stream: Tensor<3>,
+    /// The network's inputs besides M: the body points the body stream sees, GarNet-Local's
+    /// tables, the contact features and the vertex rotations.
+    pub inputs: NetInputs,
     /// Body vertices `[B,V,3]`, metres (the penetration loss).
     pub body: Tensor<3>,
     /// Unit body vertex normals `[B,V,3]`.
@@ -189,8 +244,6 @@ pub struct Batch {
     pub warped: Tensor<3>,
     /// Target garment G `[B,N,3]`, metres (present when every sample has one).
     pub target: Option<Tensor<3>>,
-    /// GarNet-Local's neighbour tables.
-    pub local: Option<LocalIndices>,
     /// Per-sample k-d trees over the body vertices (the penetration loss's nearest-vertex
     /// search), built with the batch when it has targets.
     pub(crate) body_index: Vec<Arc<geom::KnnIndex>>,
@@ -205,7 +258,7 @@ impl std::fmt::Debug for Batch {
             .field("n_body", &self.n_body)
             .field("n_garment", &self.n_garment)
             .field("has_target", &self.target.is_some())
-            .field("has_local", &self.local.is_some())
+            .field("has_local", &self.inputs.local.is_some())
             .finish()
     }
 }
@@ -266,7 +319,7 @@ impl Batch {
         let bodies: Vec<&[Vec3]> = bodies.iter().map(Vec::as_slice).collect();
         let normals: Vec<&[Vec3]> = normals.iter().map(Vec::as_slice).collect();
         let warped: Vec<&[Vec3]> = warped.iter().map(Vec::as_slice).collect();
-        let (body_stream, local) = spec.inputs(&bodies, &warped, device)?;
+        let inputs = spec.inputs(&bodies, &warped, device)?;
         let (target, target_points, body_index) = if with_target {
             let targets: Vec<&[Vec3]> = targets.iter().map(Vec::as_slice).collect();
             let index = bodies
@@ -285,7 +338,7 @@ impl Batch {
             size: samples.len(),
             n_body: v,
             n_garment: n,
-            body_stream,
+            inputs,
             body: points_tensor(&bodies, device),
             body_normals: points_tensor(&normals, device),
             body_edge: vec_tensor(
@@ -295,7 +348,6 @@ impl Batch {
             ),
             warped: points_tensor(&warped, device),
             target,
-            local,
             body_index,
             target_points,
         })

@@ -11,6 +11,7 @@
 //! | `template.faces` | U32 | `[F,3]` | its triangles |
 //! | `body.stream` | U32 | `[P]` | the body vertices the body stream sees, farthest-point order |
 //! | `garment.file` | U8 | `[L3]` | optional: the `.garment` template file M is warped with |
+//! | `body.faces` | U32 | `[F,3]` | optional: the body's triangles (networks with body-contact features) |
 //!
 //! and JSON metadata `format`, `config` ([`GarNetConfig`]), `loss` ([`LossConfig`]),
 //! `state` ([`TrainState`]), `body.n_vertices` (V) and `body.n_centres` (GarNet-Local's kept
@@ -36,6 +37,7 @@ use crate::garnet::GarNet;
 use crate::local::BodySampling;
 use crate::loss::LossConfig;
 use crate::schedule::CosineSchedule;
+use crate::vertex_frames::VertexFrames;
 
 /// The format name in a checkpoint's metadata.
 pub const FORMAT: &str = "garnet-model-1";
@@ -62,6 +64,10 @@ pub struct ModelSetup {
     /// A body given to the network must be posed the same way. `"dqs"` for checkpoints
     /// written before it was recorded (every dataset was DQS then).
     pub body_skinning: String,
+    /// The body's faces `[F]` (indices below V), which a network with body-contact features
+    /// (see [`GarNetConfig::body_contact`]) needs for the body normals; may be absent
+    /// otherwise.
+    pub body_faces: Option<Vec<[u32; 3]>>,
 }
 
 /// The names [`ModelSetup::body_skinning`] may take.
@@ -104,7 +110,16 @@ impl ModelSetup {
             garment_file: None,
             canonical_frame: true,
             body_skinning: BODY_SKINNINGS[0].into(),
+            body_faces: None,
         })
+    }
+
+    /// This setup with the body's faces `[F]` (see [`ModelSetup::body_faces`]); fails on an
+    /// index not below the body vertex count V.
+    pub fn with_body_faces(mut self, faces: Vec<[u32; 3]>) -> Result<Self> {
+        geom::adjacency::check_indices(self.body_sampling.n_body, &faces)?;
+        self.body_faces = Some(faces);
+        Ok(self)
     }
 
     /// This setup for bodies posed with the skinning named `name` (see
@@ -131,6 +146,18 @@ impl ModelSetup {
                 .has_local()
                 .then_some((self.config.pool_neighbours, self.config.local_neighbours)),
             canonical_rest: self.canonical_frame.then(|| self.template.vertices.clone()),
+            contact_faces: self
+                .config
+                .body_contact
+                .then(|| self.body_faces.clone())
+                .flatten(),
+            // A template that passes `validate` has its face indices in range, so the frames
+            // exist; otherwise the network refuses the missing rotations.
+            vertex_frames: self
+                .config
+                .vertex_frames
+                .then(|| VertexFrames::new(&self.template.vertices, &self.template.faces).ok())
+                .flatten(),
         }
     }
 
@@ -142,6 +169,15 @@ impl ModelSetup {
         self.config.validate()?;
         self.template.validate()?;
         self.body_sampling.validate()?;
+        match &self.body_faces {
+            Some(faces) => geom::adjacency::check_indices(self.body_sampling.n_body, faces)?,
+            None if self.config.body_contact => {
+                return Err(ModelError::InvalidInput(
+                    "a network with body-contact features needs the body's faces".into(),
+                ))
+            }
+            None => {}
+        }
         if self.config.variant.has_local()
             && (self.body_sampling.n_centres < self.config.local_neighbours
                 || self.body_sampling.len() < self.config.pool_neighbours)
@@ -281,6 +317,14 @@ pub fn save_checkpoint(
     if let Some(g) = &setup.garment_file {
         tensors.push(("garment.file", Dtype::U8, vec![g.len()], g.clone()));
     }
+    if let Some(f) = &setup.body_faces {
+        tensors.push((
+            "body.faces",
+            Dtype::U32,
+            vec![f.len(), 3],
+            to_le(f.iter().flatten().copied(), u32::to_le_bytes),
+        ));
+    }
     let meta: HashMap<String, String> = HashMap::from([
         ("format".into(), FORMAT.into()),
         ("config".into(), json(&setup.config)?),
@@ -326,6 +370,11 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint> {
         obj.entry("input_scale").or_insert(serde_json::json!(1.0));
         obj.entry("input_centre")
             .or_insert(serde_json::json!([0.0, 0.0, 0.0]));
+        // Those written before body-contact features and vertex frames existed have neither.
+        obj.entry("vertex_frames")
+            .or_insert(serde_json::json!(false));
+        obj.entry("body_contact")
+            .or_insert(serde_json::json!(false));
     }
     let config: GarNetConfig =
         serde_json::from_value(config_json).map_err(|e| bad(format!("metadata config: {e}")))?;
@@ -393,11 +442,21 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint> {
     } else {
         None
     };
+    let body_faces = if names.contains(&"body.faces") {
+        let flat = u32s("body.faces")?;
+        if flat.len() % 3 != 0 {
+            return Err(bad("body.faces is not [F,3]".into()));
+        }
+        Some(flat.chunks_exact(3).map(|f| [f[0], f[1], f[2]]).collect())
+    } else {
+        None
+    };
     let setup = ModelSetup {
         config,
         template,
         body_sampling,
         garment_file,
+        body_faces,
         canonical_frame: meta.get("canonical_frame").is_some_and(|v| v == "true"),
         body_skinning: meta
             .get("body.skinning")

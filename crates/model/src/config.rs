@@ -123,6 +123,17 @@ pub struct GarNetConfig {
     /// the features concatenated with the vertex positions).
     #[config(default = 1)]
     pub convs_per_block: usize,
+    /// Our extension (not in the paper): the garment stream's point-wise MLP also takes, per
+    /// vertex of M, the offset to the nearest body vertex, that vertex's normal and the signed
+    /// distance (see [`crate::contact`]). Off in the paper's networks.
+    #[config(default = false)]
+    pub body_contact: bool,
+    /// Our extension (not in the paper): the fusion network's 3 outputs are the translation
+    /// in each vertex's own frame, turned by the rotation that takes the template's vertex
+    /// frame to M's (see [`crate::vertex_frames`]), so a sleeve's sag turns with the arm.
+    /// Off in the paper's networks.
+    #[config(default = false)]
+    pub vertex_frames: bool,
     /// Width of the global garment feature (a shared layer then max pooling over vertices).
     #[config(default = 256)]
     pub garment_global: usize,

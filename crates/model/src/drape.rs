@@ -118,13 +118,10 @@ impl Draper {
         let (frames, bodies, warped) = self.spec.to_canonical(items);
         let bodies: Vec<&[Vec3]> = bodies.iter().map(Vec::as_slice).collect();
         let warped: Vec<&[Vec3]> = warped.iter().map(Vec::as_slice).collect();
-        let (stream, local) = self.spec.inputs(&bodies, &warped, &self.device)?;
-        let pred = self.model.forward(
-            stream,
-            points_tensor(&warped, &self.device),
-            &self.topo,
-            local.as_ref(),
-        )?;
+        let inputs = self.spec.inputs(&bodies, &warped, &self.device)?;
+        let pred = self
+            .model
+            .forward(&inputs, points_tensor(&warped, &self.device), &self.topo)?;
         let pred = read_points(pred)?;
         Ok(pred
             .into_iter()

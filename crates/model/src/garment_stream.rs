@@ -11,6 +11,7 @@ use burn::nn::Linear;
 use burn::prelude::*;
 
 use crate::config::GarNetConfig;
+use crate::contact::CONTACT_WIDTH;
 use crate::feast::FeaStConv;
 use crate::init::ParamInit;
 use crate::layers::{lrelu, max_points, CondLinear};
@@ -91,7 +92,7 @@ impl GarmentStream {
         let stn = Stn::new(3, &cfg.stn_mlp, &cfg.stn_fc, init, device);
         let cb = cfg.body_feature_width();
         let mut mlp = Vec::with_capacity(cfg.garment_mlp.len());
-        let mut d = 3;
+        let mut d = 3 + if cfg.body_contact { CONTACT_WIDTH } else { 0 };
         for &w in &cfg.garment_mlp {
             mlp.push(CondLinear::new(d, cb, w, init, device));
             d = w;
@@ -117,15 +118,20 @@ impl GarmentStream {
         }
     }
 
-    /// `warped` M `[B,N,3]` (metres), `body_global` `[B,Cb]` -> point-wise, patch-wise and
-    /// global garment features.
+    /// `warped` M `[B,N,3]` (network unit), `body_global` `[B,Cb]`, and with
+    /// [`GarNetConfig::body_contact`] the contact features `[B,N,CONTACT_WIDTH]` ->
+    /// point-wise, patch-wise and global garment features.
     pub fn forward(
         &self,
         warped: Tensor<3>,
         body_global: Tensor<2>,
+        contact: Option<Tensor<3>>,
         topo: &TopologyTensors,
     ) -> GarmentFeatures {
         let mut h = self.stn.forward(warped.clone());
+        if let Some(c) = contact {
+            h = Tensor::cat(vec![h, c], 2);
+        }
         for layer in &self.mlp {
             let bias = layer.cond_bias(body_global.clone());
             h = lrelu(layer.forward(h, bias));

@@ -3,13 +3,14 @@
 
 use burn::prelude::*;
 
+use crate::batch::NetInputs;
 use crate::body_stream::{BodyStream, LocalPool};
 use crate::config::{GarNetConfig, Variant};
+use crate::contact::CONTACT_WIDTH;
 use crate::error::{ModelError, Result};
 use crate::fusion::Fusion;
 use crate::garment_stream::GarmentStream;
 use crate::init::ParamInit;
-use crate::local::LocalIndices;
 use crate::topology::TopologyTensors;
 
 /// The GarNet network (any of the three variants, see [`GarNet::variant`]).
@@ -27,6 +28,17 @@ pub struct GarNet {
     pub input_scale: f32,
     /// Centre subtracted from input positions `[3]`, metres.
     pub input_centre: Vec<f32>,
+    /// Whether the translations are predicted in each vertex's frame (see
+    /// [`GarNetConfig::vertex_frames`]).
+    pub vertex_frames: bool,
+}
+
+/// `rotations` `[B,N,9]` (row-major 3x3 per vertex) applied to `t` `[B,N,3]`.
+fn rotate(rotations: Tensor<3>, t: Tensor<3>) -> Tensor<3> {
+    let [b, n, _] = t.dims();
+    let r = rotations.reshape([b, n, 3, 3]);
+    let t = t.reshape([b, n, 1, 3]);
+    (r * t).sum_dim(3).reshape([b, n, 3])
 }
 
 impl GarNetConfig {
@@ -57,6 +69,7 @@ impl GarNetConfig {
             fusion,
             input_scale: self.input_scale,
             input_centre: self.input_centre.clone(),
+            vertex_frames: self.vertex_frames,
         })
     }
 }
@@ -77,18 +90,22 @@ impl GarNet {
     /// Predicted translations `T` `[B,N,3]` (metres). Positions are moved to the network's
     /// unit ([`GarNetConfig::input_scale`]) inside.
     ///
-    /// - `body`: the body points the stream sees `[B,P,3]` (see
-    ///   [`crate::local::BodySampling::stream_points`]), metres.
+    /// - `inputs`: the body points the stream sees `[B,P,3]` (see
+    ///   [`crate::local::BodySampling::stream_points`]), metres; the neighbour tables,
+    ///   required by GarNet-Local; the body-contact features of M `[B,N,CONTACT_WIDTH]` (see
+    ///   [`crate::contact`]), required by a network that [`GarNet::takes_contact`] and refused
+    ///   by the others; the vertex rotations `[B,N,9]` (see [`crate::vertex_frames`]),
+    ///   likewise with [`GarNet::vertex_frames`].
     /// - `warped`: the DQS-warped garment M `[B,N,3]`, metres.
     /// - `topo`: the garment template's connectivity (N vertices).
-    /// - `local`: the batch's neighbour tables; required by GarNet-Local, ignored otherwise.
     pub fn translations(
         &self,
-        body: Tensor<3>,
+        inputs: &NetInputs,
         warped: Tensor<3>,
         topo: &TopologyTensors,
-        local: Option<&LocalIndices>,
     ) -> Result<Tensor<3>> {
+        let body = inputs.body_stream.clone();
+        let (local, contact) = (inputs.local.as_ref(), inputs.contact.clone());
         let [b, v, cb] = body.dims();
         let [bm, n, cm] = warped.dims();
         if cb != 3 || cm != 3 || b != bm || b == 0 || v == 0 {
@@ -104,6 +121,31 @@ impl GarNet {
                 got: n,
             });
         }
+        match &contact {
+            Some(c) if self.takes_contact() && c.dims() == [b, n, CONTACT_WIDTH] => {}
+            None if !self.takes_contact() => {}
+            _ => {
+                return Err(ModelError::InvalidInput(format!(
+                    "this network {} body-contact features [{b},{n},{CONTACT_WIDTH}], got {:?}",
+                    if self.takes_contact() {
+                        "needs"
+                    } else {
+                        "takes no"
+                    },
+                    contact.as_ref().map(|c| c.dims())
+                )))
+            }
+        }
+        if inputs.rotations.as_ref().map(|r| r.dims()) != self.vertex_frames.then_some([b, n, 9]) {
+            return Err(ModelError::InvalidInput(format!(
+                "this network {} vertex rotations [{b},{n},9]",
+                if self.vertex_frames {
+                    "needs"
+                } else {
+                    "takes no"
+                }
+            )));
+        }
         let centre = Tensor::<1>::from_floats(self.input_centre.as_slice(), &body.device())
             .reshape([1, 1, 3]);
         let unit = self.input_scale as f64;
@@ -112,7 +154,7 @@ impl GarNet {
         let body_features = self.body.forward(body);
         let garment = self
             .garment
-            .forward(warped, body_features.global.clone(), topo);
+            .forward(warped, body_features.global.clone(), contact, topo);
         let mut per_vertex = vec![garment.points];
         if let Some(p) = garment.patches {
             per_vertex.push(p);
@@ -140,19 +182,31 @@ impl GarNet {
             Tensor::cat(per_vertex, 2)
         };
         let global = Tensor::cat(vec![garment.global, body_features.global], 1);
-        Ok(self.fusion.forward(per_vertex, global) * unit)
+        let t = self.fusion.forward(per_vertex, global) * unit;
+        Ok(match &inputs.rotations {
+            Some(r) => rotate(r.clone(), t),
+            None => t,
+        })
+    }
+
+    /// Whether the network takes body-contact features (its config had
+    /// [`GarNetConfig::body_contact`]), read from the width of its first garment layer.
+    pub fn takes_contact(&self) -> bool {
+        self.garment
+            .mlp
+            .first()
+            .is_some_and(|l| l.point.weight.val().dims()[0] == 3 + CONTACT_WIDTH)
     }
 
     /// The predicted draped garment `G = M + T` `[B,N,3]` (metres); arguments as
     /// [`GarNet::translations`].
     pub fn forward(
         &self,
-        body: Tensor<3>,
+        inputs: &NetInputs,
         warped: Tensor<3>,
         topo: &TopologyTensors,
-        local: Option<&LocalIndices>,
     ) -> Result<Tensor<3>> {
-        let t = self.translations(body, warped.clone(), topo, local)?;
+        let t = self.translations(inputs, warped.clone(), topo)?;
         Ok(warped + t)
     }
 }

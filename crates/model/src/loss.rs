@@ -351,6 +351,8 @@ mod tests {
             },
             local: None,
             canonical_rest: None,
+            contact_faces: None,
+            vertex_frames: None,
         };
         let b = Batch::new(&[sample], &topo, &spec, device).unwrap();
         (b, topo.to_device(device))
@@ -517,6 +519,8 @@ mod tests {
             },
             local: None,
             canonical_rest: None,
+            contact_faces: None,
+            vertex_frames: None,
         };
         let cfg = LossConfig::new().with_units_per_metre(1.0);
         let loss_at = |p: &[Vec3]| -> f64 {

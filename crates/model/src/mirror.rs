@@ -245,6 +245,8 @@ mod tests {
             sampling: crate::local::BodySampling::farthest_point(&rest, 1, 4).unwrap(),
             local: None,
             canonical_rest: Some(garment.clone()),
+            contact_faces: None,
+            vertex_frames: None,
         };
         let map = MirrorMap::new(&TriMesh::new(garment.clone(), faces.clone())).unwrap();
         let m = map.mirror_sample(&sample, &spec).unwrap();

@@ -1,6 +1,7 @@
 //! One optimisation step and one evaluation pass over a batch.
 
 use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
+use burn::prelude::Tensor;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
@@ -60,6 +61,11 @@ pub struct StepReport {
     pub grad_norm: f32,
 }
 
+/// The network's drapes `[B,N,3]` (metres) of `batch`.
+fn predict(model: &GarNet, batch: &Batch, topo: &TopologyTensors) -> Result<Tensor<3>> {
+    model.forward(&batch.inputs, batch.warped.clone(), topo)
+}
+
 /// One Adam step on `batch` (which must have targets and live on an autodiff device, as
 /// `model` does): forward, loss, backward, gradients scaled to a joint L2 norm of at most
 /// `max_grad_norm` when given (see [`crate::grad_clip`]), update `model` in place. Fails
@@ -73,12 +79,7 @@ pub fn train_step(
     lr: f64,
     max_grad_norm: Option<f32>,
 ) -> Result<StepReport> {
-    let pred = model.forward(
-        batch.body_stream.clone(),
-        batch.warped.clone(),
-        topo,
-        batch.local.as_ref(),
-    )?;
+    let pred = predict(model, batch, topo)?;
     let loss = garnet_loss(pred, batch, topo, loss_cfg)?;
     let terms = loss.values()?;
     if !terms.total.is_finite() {
@@ -121,14 +122,7 @@ pub fn evaluate_batch(
     faces: &[[u32; 3]],
     loss_cfg: &LossConfig,
 ) -> Result<Evaluation> {
-    let pred = model
-        .forward(
-            batch.body_stream.clone(),
-            batch.warped.clone(),
-            topo,
-            batch.local.as_ref(),
-        )?
-        .detach();
+    let pred = predict(model, batch, topo)?.detach();
     let terms = garnet_loss(pred.clone(), batch, topo, loss_cfg)?.values()?;
     let predictions = read_points(pred)?;
     let targets = batch.target_points().unwrap_or(&[]);

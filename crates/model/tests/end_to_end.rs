@@ -48,13 +48,12 @@ fn every_variant_outputs_b_n_3() {
         let model = s.config.init(&device).unwrap();
         let topo = GarmentTopology::from_mesh(&s.template).unwrap();
         let batch = Batch::new(&samples(&s, 2), &topo, &s.input_spec(), &device).unwrap();
-        assert_eq!(batch.local.is_some(), variant == Variant::Local);
+        assert_eq!(batch.inputs.local.is_some(), variant == Variant::Local);
         let out = model
             .forward(
-                batch.body_stream.clone(),
+                &batch.inputs,
                 batch.warped.clone(),
                 &topo.to_device(&device),
-                batch.local.as_ref(),
             )
             .unwrap();
         assert_eq!(out.dims(), [2, n, 3], "{variant:?}");
@@ -86,15 +85,129 @@ fn local_variant_needs_its_tables() {
     let model = s.config.init(&device).unwrap();
     let topo = GarmentTopology::from_mesh(&s.template).unwrap();
     let batch = Batch::new(&samples(&s, 1), &topo, &s.input_spec(), &device).unwrap();
+    let mut inputs = batch.inputs.clone();
+    inputs.local = None;
     let err = model
-        .forward(
-            batch.body_stream,
-            batch.warped,
-            &topo.to_device(&device),
-            None,
-        )
+        .forward(&inputs, batch.warped, &topo.to_device(&device))
         .unwrap_err();
     assert!(err.to_string().contains("local tables"), "{err}");
+}
+
+/// A closed ellipsoid body with faces (an icosphere, 642 vertices) and its topology.
+fn meshed_body() -> (Vec<Vec3>, BodyTopology) {
+    use model::synthetic::{BODY_CENTRE, BODY_RADII};
+    let sphere = geom::TriMesh::icosphere(3, 1.0);
+    let body: Vec<Vec3> = sphere
+        .vertices
+        .iter()
+        .map(|v| BODY_CENTRE + *v * BODY_RADII)
+        .collect();
+    let topology = BodyTopology::new(body.len(), sphere.faces).unwrap();
+    (body, topology)
+}
+
+/// A network with body-contact features and vertex frames gets them from its batches (the
+/// features of `model::contact` on the body and M; the identity rotations of M = template),
+/// through a checkpoint and in a drape; it refuses to run without them, and a network without
+/// them refuses them.
+#[test]
+fn extended_network_takes_its_inputs_and_only_it() {
+    let device = Device::flex();
+    let (body, body_topo) = meshed_body();
+    let cfg = GarNetConfig::tiny(Variant::Local)
+        .with_body_contact(true)
+        .with_vertex_frames(true);
+    let template = tube_garment(60);
+    let setup = ModelSetup::new(cfg.clone(), template.clone(), &body).unwrap();
+    assert!(setup.validate().is_err(), "no body faces");
+    let setup = setup.with_body_faces(body_topo.faces.clone()).unwrap();
+    let model = setup.config.init(&device).unwrap();
+    assert!(model.takes_contact() && model.vertex_frames);
+    let sample = Sample::new(
+        body.clone(),
+        &body_topo,
+        template.vertices.clone(),
+        Some(model::synthetic::smooth_displacement(
+            &template.vertices,
+            0.3,
+        )),
+    )
+    .unwrap();
+    let topo = GarmentTopology::from_mesh(&template).unwrap();
+    let topo_t = topo.to_device(&device);
+    let batch = Batch::new(&[sample], &topo, &setup.input_spec(), &device).unwrap();
+    let contact = batch.inputs.contact.clone().expect("contact features");
+    // M is the template, so the canonical frame and the rotations are the identity.
+    let normals = geom::normals::vertex_normals(&body, &body_topo.faces);
+    let index = geom::KnnIndex::new(&body).unwrap();
+    let want =
+        model::contact::contact_features(&index, &body, &normals, &template.vertices).unwrap();
+    let got = model::tensors::read_f32(contact.clone()).unwrap();
+    assert_eq!(contact.dims(), [1, 60, model::contact::CONTACT_WIDTH]);
+    let worst = got
+        .iter()
+        .zip(&want)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f32::max);
+    assert!(worst < 1e-3, "{worst}");
+    let rotations = model::tensors::read_f32(batch.inputs.rotations.clone().unwrap()).unwrap();
+    let identity = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+    assert!(rotations
+        .chunks_exact(9)
+        .all(|r| r.iter().zip(identity).all(|(a, b)| (a - b).abs() < 1e-3)));
+    let run =
+        |m: &model::GarNet, inputs: &NetInputs| m.forward(inputs, batch.warped.clone(), &topo_t);
+    let pred = model::tensors::read_points(run(&model, &batch.inputs).unwrap()).unwrap();
+    let without = |contact: bool, rotations: bool| {
+        let mut i = batch.inputs.clone();
+        if !contact {
+            i.contact = None;
+        }
+        if !rotations {
+            i.rotations = None;
+        }
+        i
+    };
+    let err = run(&model, &without(false, true)).unwrap_err().to_string();
+    assert!(err.contains("needs body-contact features"), "{err}");
+    let err = run(&model, &without(true, false)).unwrap_err().to_string();
+    assert!(err.contains("needs vertex rotations"), "{err}");
+    let plain = cfg
+        .with_body_contact(false)
+        .with_vertex_frames(false)
+        .init(&device)
+        .unwrap();
+    assert!(!plain.takes_contact() && !plain.vertex_frames);
+    let err = run(&plain, &without(true, false)).unwrap_err().to_string();
+    assert!(err.contains("takes no body-contact features"), "{err}");
+    let err = run(&plain, &without(false, true)).unwrap_err().to_string();
+    assert!(err.contains("takes no vertex rotations"), "{err}");
+    assert!(run(&plain, &without(false, false)).is_ok());
+    // Through a checkpoint: the faces come back and a drape computes the same inputs.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("c.garnet");
+    save_checkpoint(
+        &path,
+        &model,
+        None,
+        &setup,
+        &LossConfig::new(),
+        &TrainState::default(),
+    )
+    .unwrap();
+    let ck = load_checkpoint(&path).unwrap();
+    assert_eq!(ck.setup.body_faces.as_ref(), Some(&body_topo.faces));
+    let draper = Draper::load(&path, &device).unwrap();
+    let draped = draper.drape(&body, &template.vertices).unwrap();
+    let gap = draped
+        .iter()
+        .zip(&pred[0])
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0, f32::max);
+    assert!(
+        gap < 1e-5,
+        "drape differs from the batch forward by {gap} m"
+    );
 }
 
 #[test]
