@@ -218,11 +218,11 @@ pub fn run(args: &DrapeArgs) -> anyhow::Result<()> {
             )
         });
         eprintln!(
-            "{} ({} vertices, GarNet-{}) on a {:.1} cm body, {what}: warp {warp_ms:.1} ms, \
+            "{} ({} vertices, {}) on a {:.1} cm body, {what}: warp {warp_ms:.1} ms, \
              network {net_ms:.1} ms{pushed}",
             template.kind.name(),
             draped.len(),
-            draper.setup().config.variant.name(),
+            draper.setup().config.method_name(),
             target.height() * 100.0
         );
         let mesh = TriMesh {

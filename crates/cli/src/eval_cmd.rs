@@ -259,7 +259,7 @@ impl EvalData {
         if let Some(n) = max_samples {
             indices.truncate(n);
         }
-        let method = format!("GarNet-{}", draper.setup().config.variant.name());
+        let method = draper.setup().config.method_name();
         eprintln!(
             "{}: {method} on {} '{garment}' samples",
             path.display(),

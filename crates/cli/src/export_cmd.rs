@@ -232,15 +232,12 @@ fn model_card(
         dir = data.dir().display(),
     );
     let mut rows = vec![
-        (format!("GarNet-{}", cfg.variant.name()), net),
+        (cfg.method_name(), net),
         ("DQS warp (the input M)".to_string(), dqs),
     ];
     if let Some((f, e)) = filtered {
         let [net, dqs] = e.summary();
-        rows.push((
-            format!("GarNet-{}, {}", cfg.variant.name(), f.describe()),
-            net,
-        ));
+        rows.push((format!("{}, {}", cfg.method_name(), f.describe()), net));
         rows.push((format!("DQS warp, {}", f.describe()), dqs));
     }
     for (method, (samples, dist, norm, inside)) in rows {

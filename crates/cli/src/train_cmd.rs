@@ -301,9 +301,9 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
     );
     let params = trainer.model().num_params();
     eprintln!(
-        "training GarNet-{} ({params} parameters) on {} '{}' samples ({} validation), \
+        "training {} ({params} parameters) on {} '{}' samples ({} validation), \
          batch {}, lr {}{}{}, into {}",
-        variant.name(),
+        trainer.setup().config.method_name(),
         train.indices.len(),
         args.garment,
         valid.as_ref().map_or(0, |v| v.indices.len()),

@@ -231,6 +231,19 @@ impl GarNetConfig {
         Ok(())
     }
 
+    /// The network's name in reports: `GarNet-local` (the variant's name), followed by
+    /// ` +contact` and ` +frames` when it has our extensions.
+    pub fn method_name(&self) -> String {
+        let mut name = format!("GarNet-{}", self.variant.name());
+        if self.body_contact {
+            name.push_str(" +contact");
+        }
+        if self.vertex_frames {
+            name.push_str(" +frames");
+        }
+        name
+    }
+
     /// Width of the point-wise (and global) body features.
     pub fn body_feature_width(&self) -> usize {
         *self.body_mlp2.last().unwrap_or(&0)
@@ -239,5 +252,26 @@ impl GarNetConfig {
     /// Width of the point-wise garment features.
     pub fn garment_point_width(&self) -> usize {
         *self.garment_mlp.last().unwrap_or(&0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn method_names_say_the_variant_and_the_extensions() {
+        assert_eq!(
+            GarNetConfig::new(Variant::Local).method_name(),
+            "GarNet-local"
+        );
+        let both = GarNetConfig::new(Variant::Global)
+            .with_body_contact(true)
+            .with_vertex_frames(true);
+        assert_eq!(both.method_name(), "GarNet-global +contact +frames");
+        assert_eq!(
+            both.with_body_contact(false).method_name(),
+            "GarNet-global +frames"
+        );
     }
 }
