@@ -116,6 +116,9 @@ pub struct InputSpec {
     /// The garment's vertex frames when the network predicts in them (see
     /// [`crate::vertex_frames`]).
     pub vertex_frames: Option<VertexFrames>,
+    /// The template's vertices `[N]` (metres) when the network takes them as an input (see
+    /// [`crate::GarNetConfig::rest_input`]).
+    pub rest_input: Option<Vec<Vec3>>,
 }
 
 impl InputSpec {
@@ -198,11 +201,16 @@ impl InputSpec {
             }
             None => None,
         };
+        let rest = self.rest_input.as_ref().map(|r| {
+            let copies: Vec<&[Vec3]> = warped.iter().map(|_| r.as_slice()).collect();
+            points_tensor(&copies, device)
+        });
         Ok(NetInputs {
             body_stream: points_tensor(&refs, device),
             local,
             contact,
             rotations,
+            rest,
         })
     }
 }
@@ -220,6 +228,8 @@ pub struct NetInputs {
     /// Rotations `[B,N,9]` from the template's vertex frames to M's, row-major (see
     /// [`crate::vertex_frames`]).
     pub rotations: Option<Tensor<3>>,
+    /// The template's vertices `[B,N,3]`, metres (see [`crate::GarNetConfig::rest_input`]).
+    pub rest: Option<Tensor<3>>,
 }
 
 /// A batch of B samples as tensors on one device, sharing one garment topology.

@@ -151,6 +151,10 @@ impl ModelSetup {
                 .body_contact
                 .then(|| self.body_faces.clone())
                 .flatten(),
+            rest_input: self
+                .config
+                .rest_input
+                .then(|| self.template.vertices.clone()),
             // A template that passes `validate` has its face indices in range, so the frames
             // exist; otherwise the network refuses the missing rotations.
             vertex_frames: self
@@ -373,6 +377,7 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint> {
         // Those written before body-contact features and vertex frames existed have neither.
         obj.entry("vertex_frames")
             .or_insert(serde_json::json!(false));
+        obj.entry("rest_input").or_insert(serde_json::json!(false));
         obj.entry("body_contact")
             .or_insert(serde_json::json!(false));
     }

@@ -134,6 +134,11 @@ pub struct GarNetConfig {
     /// Off in the paper's networks.
     #[config(default = false)]
     pub vertex_frames: bool,
+    /// Our extension (not in the paper): the garment stream's point-wise MLP also takes each
+    /// vertex's position on the template (the same for every sample), so the network knows
+    /// which vertex it is looking at whatever the pose. Off in the paper's networks.
+    #[config(default = false)]
+    pub rest_input: bool,
     /// Width of the global garment feature (a shared layer then max pooling over vertices).
     #[config(default = 256)]
     pub garment_global: usize,
@@ -240,6 +245,9 @@ impl GarNetConfig {
         }
         if self.vertex_frames {
             name.push_str(" +frames");
+        }
+        if self.rest_input {
+            name.push_str(" +rest");
         }
         name
     }

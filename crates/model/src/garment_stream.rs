@@ -92,7 +92,13 @@ impl GarmentStream {
         let stn = Stn::new(3, &cfg.stn_mlp, &cfg.stn_fc, init, device);
         let cb = cfg.body_feature_width();
         let mut mlp = Vec::with_capacity(cfg.garment_mlp.len());
-        let mut d = 3 + if cfg.body_contact { CONTACT_WIDTH } else { 0 };
+        let mut d = 3;
+        if cfg.rest_input {
+            d += 3;
+        }
+        if cfg.body_contact {
+            d += CONTACT_WIDTH;
+        }
         for &w in &cfg.garment_mlp {
             mlp.push(CondLinear::new(d, cb, w, init, device));
             d = w;
@@ -118,19 +124,21 @@ impl GarmentStream {
         }
     }
 
-    /// `warped` M `[B,N,3]` (network unit), `body_global` `[B,Cb]`, and with
-    /// [`GarNetConfig::body_contact`] the contact features `[B,N,CONTACT_WIDTH]` ->
-    /// point-wise, patch-wise and global garment features.
+    /// `warped` M `[B,N,3]` (network unit), `body_global` `[B,Cb]`, and the extra per-vertex
+    /// inputs of the first layer (with [`GarNetConfig::rest_input`] the template's vertices
+    /// `[B,N,3]` in the network unit, with [`GarNetConfig::body_contact`] the contact features
+    /// `[B,N,CONTACT_WIDTH]`, in that order) -> point-wise, patch-wise and global garment
+    /// features.
     pub fn forward(
         &self,
         warped: Tensor<3>,
         body_global: Tensor<2>,
-        contact: Option<Tensor<3>>,
+        extra: Vec<Tensor<3>>,
         topo: &TopologyTensors,
     ) -> GarmentFeatures {
         let mut h = self.stn.forward(warped.clone());
-        if let Some(c) = contact {
-            h = Tensor::cat(vec![h, c], 2);
+        if !extra.is_empty() {
+            h = Tensor::cat([vec![h], extra].concat(), 2);
         }
         for layer in &self.mlp {
             let bias = layer.cond_bias(body_global.clone());

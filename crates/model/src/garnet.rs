@@ -31,6 +31,10 @@ pub struct GarNet {
     /// Whether the translations are predicted in each vertex's frame (see
     /// [`GarNetConfig::vertex_frames`]).
     pub vertex_frames: bool,
+    /// Whether the garment stream takes body-contact features ([`GarNetConfig::body_contact`]).
+    pub body_contact: bool,
+    /// Whether the garment stream takes the template's vertices ([`GarNetConfig::rest_input`]).
+    pub rest_input: bool,
 }
 
 /// `rotations` `[B,N,9]` (row-major 3x3 per vertex) applied to `t` `[B,N,3]`.
@@ -70,6 +74,8 @@ impl GarNetConfig {
             input_scale: self.input_scale,
             input_centre: self.input_centre.clone(),
             vertex_frames: self.vertex_frames,
+            body_contact: self.body_contact,
+            rest_input: self.rest_input,
         })
     }
 }
@@ -94,8 +100,9 @@ impl GarNet {
     ///   [`crate::local::BodySampling::stream_points`]), metres; the neighbour tables,
     ///   required by GarNet-Local; the body-contact features of M `[B,N,CONTACT_WIDTH]` (see
     ///   [`crate::contact`]), required by a network that [`GarNet::takes_contact`] and refused
-    ///   by the others; the vertex rotations `[B,N,9]` (see [`crate::vertex_frames`]),
-    ///   likewise with [`GarNet::vertex_frames`].
+    ///   by the others; the vertex rotations `[B,N,9]` (see [`crate::vertex_frames`]) and
+    ///   the template's vertices `[B,N,3]` (metres), likewise with [`GarNet::vertex_frames`]
+    ///   and [`GarNet::rest_input`].
     /// - `warped`: the DQS-warped garment M `[B,N,3]`, metres.
     /// - `topo`: the garment template's connectivity (N vertices).
     pub fn translations(
@@ -136,25 +143,32 @@ impl GarNet {
                 )))
             }
         }
-        if inputs.rotations.as_ref().map(|r| r.dims()) != self.vertex_frames.then_some([b, n, 9]) {
-            return Err(ModelError::InvalidInput(format!(
-                "this network {} vertex rotations [{b},{n},9]",
-                if self.vertex_frames {
-                    "needs"
-                } else {
-                    "takes no"
-                }
-            )));
+        let extras = [
+            (&inputs.rotations, self.vertex_frames, 9, "vertex rotations"),
+            (&inputs.rest, self.rest_input, 3, "template vertices"),
+        ];
+        for (given, wanted, width, what) in extras {
+            if given.as_ref().map(|r| r.dims()) != wanted.then_some([b, n, width]) {
+                return Err(ModelError::InvalidInput(format!(
+                    "this network {} {what} [{b},{n},{width}]",
+                    if wanted { "needs" } else { "takes no" }
+                )));
+            }
         }
         let centre = Tensor::<1>::from_floats(self.input_centre.as_slice(), &body.device())
             .reshape([1, 1, 3]);
         let unit = self.input_scale as f64;
         let body = (body - centre.clone()) / unit;
-        let warped = (warped - centre) / unit;
+        let warped = (warped - centre.clone()) / unit;
+        let mut extra = Vec::new();
+        if let Some(r) = &inputs.rest {
+            extra.push((r.clone() - centre) / unit);
+        }
+        extra.extend(contact);
         let body_features = self.body.forward(body);
         let garment = self
             .garment
-            .forward(warped, body_features.global.clone(), contact, topo);
+            .forward(warped, body_features.global.clone(), extra, topo);
         let mut per_vertex = vec![garment.points];
         if let Some(p) = garment.patches {
             per_vertex.push(p);
@@ -190,12 +204,9 @@ impl GarNet {
     }
 
     /// Whether the network takes body-contact features (its config had
-    /// [`GarNetConfig::body_contact`]), read from the width of its first garment layer.
+    /// [`GarNetConfig::body_contact`]).
     pub fn takes_contact(&self) -> bool {
-        self.garment
-            .mlp
-            .first()
-            .is_some_and(|l| l.point.weight.val().dims()[0] == 3 + CONTACT_WIDTH)
+        self.body_contact
     }
 
     /// The predicted draped garment `G = M + T` `[B,N,3]` (metres); arguments as

@@ -353,6 +353,7 @@ mod tests {
             canonical_rest: None,
             contact_faces: None,
             vertex_frames: None,
+            rest_input: None,
         };
         let b = Batch::new(&[sample], &topo, &spec, device).unwrap();
         (b, topo.to_device(device))
@@ -521,6 +522,7 @@ mod tests {
             canonical_rest: None,
             contact_faces: None,
             vertex_frames: None,
+            rest_input: None,
         };
         let cfg = LossConfig::new().with_units_per_metre(1.0);
         let loss_at = |p: &[Vec3]| -> f64 {

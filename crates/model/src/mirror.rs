@@ -247,6 +247,7 @@ mod tests {
             canonical_rest: Some(garment.clone()),
             contact_faces: None,
             vertex_frames: None,
+            rest_input: None,
         };
         let map = MirrorMap::new(&TriMesh::new(garment.clone(), faces.clone())).unwrap();
         let m = map.mirror_sample(&sample, &spec).unwrap();

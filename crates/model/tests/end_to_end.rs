@@ -116,13 +116,14 @@ fn extended_network_takes_its_inputs_and_only_it() {
     let (body, body_topo) = meshed_body();
     let cfg = GarNetConfig::tiny(Variant::Local)
         .with_body_contact(true)
-        .with_vertex_frames(true);
+        .with_vertex_frames(true)
+        .with_rest_input(true);
     let template = tube_garment(60);
     let setup = ModelSetup::new(cfg.clone(), template.clone(), &body).unwrap();
     assert!(setup.validate().is_err(), "no body faces");
     let setup = setup.with_body_faces(body_topo.faces.clone()).unwrap();
     let model = setup.config.init(&device).unwrap();
-    assert!(model.takes_contact() && model.vertex_frames);
+    assert!(model.takes_contact() && model.vertex_frames && model.rest_input);
     let sample = Sample::new(
         body.clone(),
         &body_topo,
@@ -158,31 +159,41 @@ fn extended_network_takes_its_inputs_and_only_it() {
     let run =
         |m: &model::GarNet, inputs: &NetInputs| m.forward(inputs, batch.warped.clone(), &topo_t);
     let pred = model::tensors::read_points(run(&model, &batch.inputs).unwrap()).unwrap();
-    let without = |contact: bool, rotations: bool| {
+    // Each extra input left out (bit 0 contact, 1 rotations, 2 template vertices).
+    let without = |leave_out: u8| {
         let mut i = batch.inputs.clone();
-        if !contact {
+        if leave_out & 1 != 0 {
             i.contact = None;
         }
-        if !rotations {
+        if leave_out & 2 != 0 {
             i.rotations = None;
+        }
+        if leave_out & 4 != 0 {
+            i.rest = None;
         }
         i
     };
-    let err = run(&model, &without(false, true)).unwrap_err().to_string();
-    assert!(err.contains("needs body-contact features"), "{err}");
-    let err = run(&model, &without(true, false)).unwrap_err().to_string();
-    assert!(err.contains("needs vertex rotations"), "{err}");
+    let wants = [
+        "body-contact features",
+        "vertex rotations",
+        "template vertices",
+    ];
     let plain = cfg
         .with_body_contact(false)
         .with_vertex_frames(false)
+        .with_rest_input(false)
         .init(&device)
         .unwrap();
-    assert!(!plain.takes_contact() && !plain.vertex_frames);
-    let err = run(&plain, &without(true, false)).unwrap_err().to_string();
-    assert!(err.contains("takes no body-contact features"), "{err}");
-    let err = run(&plain, &without(false, true)).unwrap_err().to_string();
-    assert!(err.contains("takes no vertex rotations"), "{err}");
-    assert!(run(&plain, &without(false, false)).is_ok());
+    assert!(!plain.takes_contact() && !plain.vertex_frames && !plain.rest_input);
+    for (bit, what) in wants.iter().enumerate() {
+        let err = run(&model, &without(1 << bit)).unwrap_err().to_string();
+        assert!(err.contains(&format!("needs {what}")), "{err}");
+        let err = run(&plain, &without(7 & !(1 << bit)))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(&format!("takes no {what}")), "{err}");
+    }
+    assert!(run(&plain, &without(7)).is_ok());
     // Through a checkpoint: the faces come back and a drape computes the same inputs.
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("c.garnet");
