@@ -12,7 +12,6 @@ use crate::frame::CanonicalFrame;
 use crate::local::{BodySampling, LocalIndices};
 use crate::tensors::{points_tensor, vec_tensor};
 use crate::topology::GarmentTopology;
-use crate::vertex_frames::VertexFrames;
 
 /// The body mesh connectivity shared by the samples of a dataset (all bodies have one
 /// topology): faces and unique edges, for the body normals and mean edge length that the
@@ -113,9 +112,6 @@ pub struct InputSpec {
     /// The body faces `[F]` when the network takes body-contact features (see
     /// [`crate::contact`]; the faces give the body normals).
     pub contact_faces: Option<Vec<[u32; 3]>>,
-    /// The garment's vertex frames when the network predicts in them (see
-    /// [`crate::vertex_frames`]).
-    pub vertex_frames: Option<VertexFrames>,
     /// The template's vertices `[N]` (metres) when the network takes them as an input (see
     /// [`crate::GarNetConfig::rest_input`]).
     pub rest_input: Option<Vec<Vec3>>,
@@ -190,17 +186,6 @@ impl InputSpec {
             }
             None => None,
         };
-        let rotations = match &self.vertex_frames {
-            Some(frames) => {
-                let mut flat = Vec::new();
-                for m in warped {
-                    flat.extend(frames.rotations(m)?);
-                }
-                let n = warped.first().map_or(0, |m| m.len());
-                Some(vec_tensor(flat, [warped.len(), n, 9], device))
-            }
-            None => None,
-        };
         let rest = self.rest_input.as_ref().map(|r| {
             let copies: Vec<&[Vec3]> = warped.iter().map(|_| r.as_slice()).collect();
             points_tensor(&copies, device)
@@ -209,7 +194,6 @@ impl InputSpec {
             body_stream: points_tensor(&refs, device),
             local,
             contact,
-            rotations,
             rest,
         })
     }
@@ -225,9 +209,6 @@ pub struct NetInputs {
     pub local: Option<LocalIndices>,
     /// Body-contact features `[B,N,CONTACT_WIDTH]` (see [`crate::contact`]).
     pub contact: Option<Tensor<3>>,
-    /// Rotations `[B,N,9]` from the template's vertex frames to M's, row-major (see
-    /// [`crate::vertex_frames`]).
-    pub rotations: Option<Tensor<3>>,
     /// The template's vertices `[B,N,3]`, metres (see [`crate::GarNetConfig::rest_input`]).
     pub rest: Option<Tensor<3>>,
 }
@@ -242,7 +223,7 @@ pub struct Batch {
     /// Garment vertices per sample N.
     pub n_garment: usize,
     /// The network's inputs besides M: the body points the body stream sees, GarNet-Local's
-    /// tables, the contact features and the vertex rotations.
+    /// tables, the contact features and the template's vertices.
     pub inputs: NetInputs,
     /// Body vertices `[B,V,3]`, metres (the penetration loss).
     pub body: Tensor<3>,

@@ -37,7 +37,6 @@ use crate::garnet::GarNet;
 use crate::local::BodySampling;
 use crate::loss::LossConfig;
 use crate::schedule::CosineSchedule;
-use crate::vertex_frames::VertexFrames;
 
 /// The format name in a checkpoint's metadata.
 pub const FORMAT: &str = "garnet-model-1";
@@ -155,13 +154,6 @@ impl ModelSetup {
                 .config
                 .rest_input
                 .then(|| self.template.vertices.clone()),
-            // A template that passes `validate` has its face indices in range, so the frames
-            // exist; otherwise the network refuses the missing rotations.
-            vertex_frames: self
-                .config
-                .vertex_frames
-                .then(|| VertexFrames::new(&self.template.vertices, &self.template.faces).ok())
-                .flatten(),
         }
     }
 
@@ -374,9 +366,7 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint> {
         obj.entry("input_scale").or_insert(serde_json::json!(1.0));
         obj.entry("input_centre")
             .or_insert(serde_json::json!([0.0, 0.0, 0.0]));
-        // Those written before body-contact features and vertex frames existed have neither.
-        obj.entry("vertex_frames")
-            .or_insert(serde_json::json!(false));
+        // Those written before the extra inputs existed take none.
         obj.entry("rest_input").or_insert(serde_json::json!(false));
         obj.entry("body_contact")
             .or_insert(serde_json::json!(false));

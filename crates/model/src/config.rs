@@ -128,12 +128,6 @@ pub struct GarNetConfig {
     /// distance (see [`crate::contact`]). Off in the paper's networks.
     #[config(default = false)]
     pub body_contact: bool,
-    /// Our extension (not in the paper): the fusion network's 3 outputs are the translation
-    /// in each vertex's own frame, turned by the rotation that takes the template's vertex
-    /// frame to M's (see [`crate::vertex_frames`]), so a sleeve's sag turns with the arm.
-    /// Off in the paper's networks.
-    #[config(default = false)]
-    pub vertex_frames: bool,
     /// Our extension (not in the paper): the garment stream's point-wise MLP also takes each
     /// vertex's position on the template (the same for every sample), so the network knows
     /// which vertex it is looking at whatever the pose. Off in the paper's networks.
@@ -237,14 +231,11 @@ impl GarNetConfig {
     }
 
     /// The network's name in reports: `GarNet-local` (the variant's name), followed by
-    /// ` +contact` and ` +frames` when it has our extensions.
+    /// ` +contact` and ` +rest` when it has our extensions.
     pub fn method_name(&self) -> String {
         let mut name = format!("GarNet-{}", self.variant.name());
         if self.body_contact {
             name.push_str(" +contact");
-        }
-        if self.vertex_frames {
-            name.push_str(" +frames");
         }
         if self.rest_input {
             name.push_str(" +rest");
@@ -275,11 +266,11 @@ mod tests {
         );
         let both = GarNetConfig::new(Variant::Global)
             .with_body_contact(true)
-            .with_vertex_frames(true);
-        assert_eq!(both.method_name(), "GarNet-global +contact +frames");
+            .with_rest_input(true);
+        assert_eq!(both.method_name(), "GarNet-global +contact +rest");
         assert_eq!(
             both.with_body_contact(false).method_name(),
-            "GarNet-global +frames"
+            "GarNet-global +rest"
         );
     }
 }

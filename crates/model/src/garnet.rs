@@ -28,21 +28,10 @@ pub struct GarNet {
     pub input_scale: f32,
     /// Centre subtracted from input positions `[3]`, metres.
     pub input_centre: Vec<f32>,
-    /// Whether the translations are predicted in each vertex's frame (see
-    /// [`GarNetConfig::vertex_frames`]).
-    pub vertex_frames: bool,
     /// Whether the garment stream takes body-contact features ([`GarNetConfig::body_contact`]).
     pub body_contact: bool,
     /// Whether the garment stream takes the template's vertices ([`GarNetConfig::rest_input`]).
     pub rest_input: bool,
-}
-
-/// `rotations` `[B,N,9]` (row-major 3x3 per vertex) applied to `t` `[B,N,3]`.
-fn rotate(rotations: Tensor<3>, t: Tensor<3>) -> Tensor<3> {
-    let [b, n, _] = t.dims();
-    let r = rotations.reshape([b, n, 3, 3]);
-    let t = t.reshape([b, n, 1, 3]);
-    (r * t).sum_dim(3).reshape([b, n, 3])
 }
 
 impl GarNetConfig {
@@ -73,7 +62,6 @@ impl GarNetConfig {
             fusion,
             input_scale: self.input_scale,
             input_centre: self.input_centre.clone(),
-            vertex_frames: self.vertex_frames,
             body_contact: self.body_contact,
             rest_input: self.rest_input,
         })
@@ -100,9 +88,8 @@ impl GarNet {
     ///   [`crate::local::BodySampling::stream_points`]), metres; the neighbour tables,
     ///   required by GarNet-Local; the body-contact features of M `[B,N,CONTACT_WIDTH]` (see
     ///   [`crate::contact`]), required by a network that [`GarNet::takes_contact`] and refused
-    ///   by the others; the vertex rotations `[B,N,9]` (see [`crate::vertex_frames`]) and
-    ///   the template's vertices `[B,N,3]` (metres), likewise with [`GarNet::vertex_frames`]
-    ///   and [`GarNet::rest_input`].
+    ///   by the others; the template's vertices `[B,N,3]` (metres), likewise with
+    ///   [`GarNet::rest_input`].
     /// - `warped`: the DQS-warped garment M `[B,N,3]`, metres.
     /// - `topo`: the garment template's connectivity (N vertices).
     pub fn translations(
@@ -143,17 +130,11 @@ impl GarNet {
                 )))
             }
         }
-        let extras = [
-            (&inputs.rotations, self.vertex_frames, 9, "vertex rotations"),
-            (&inputs.rest, self.rest_input, 3, "template vertices"),
-        ];
-        for (given, wanted, width, what) in extras {
-            if given.as_ref().map(|r| r.dims()) != wanted.then_some([b, n, width]) {
-                return Err(ModelError::InvalidInput(format!(
-                    "this network {} {what} [{b},{n},{width}]",
-                    if wanted { "needs" } else { "takes no" }
-                )));
-            }
+        if inputs.rest.as_ref().map(|r| r.dims()) != self.rest_input.then_some([b, n, 3]) {
+            return Err(ModelError::InvalidInput(format!(
+                "this network {} template vertices [{b},{n},3]",
+                if self.rest_input { "needs" } else { "takes no" }
+            )));
         }
         let centre = Tensor::<1>::from_floats(self.input_centre.as_slice(), &body.device())
             .reshape([1, 1, 3]);
@@ -196,11 +177,7 @@ impl GarNet {
             Tensor::cat(per_vertex, 2)
         };
         let global = Tensor::cat(vec![garment.global, body_features.global], 1);
-        let t = self.fusion.forward(per_vertex, global) * unit;
-        Ok(match &inputs.rotations {
-            Some(r) => rotate(r.clone(), t),
-            None => t,
-        })
+        Ok(self.fusion.forward(per_vertex, global) * unit)
     }
 
     /// Whether the network takes body-contact features (its config had

@@ -61,7 +61,6 @@ pub mod tensors;
 pub mod topology;
 pub mod train;
 pub mod trainer;
-pub mod vertex_frames;
 
 pub use alloc::tune_allocator;
 pub use batch::{Batch, BodyTopology, InputSpec, NetInputs, Sample};

@@ -352,7 +352,6 @@ mod tests {
             local: None,
             canonical_rest: None,
             contact_faces: None,
-            vertex_frames: None,
             rest_input: None,
         };
         let b = Batch::new(&[sample], &topo, &spec, device).unwrap();
@@ -521,7 +520,6 @@ mod tests {
             local: None,
             canonical_rest: None,
             contact_faces: None,
-            vertex_frames: None,
             rest_input: None,
         };
         let cfg = LossConfig::new().with_units_per_metre(1.0);

@@ -246,7 +246,6 @@ mod tests {
             local: None,
             canonical_rest: Some(garment.clone()),
             contact_faces: None,
-            vertex_frames: None,
             rest_input: None,
         };
         let map = MirrorMap::new(&TriMesh::new(garment.clone(), faces.clone())).unwrap();

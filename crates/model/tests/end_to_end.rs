@@ -106,24 +106,23 @@ fn meshed_body() -> (Vec<Vec3>, BodyTopology) {
     (body, topology)
 }
 
-/// A network with body-contact features and vertex frames gets them from its batches (the
-/// features of `model::contact` on the body and M; the identity rotations of M = template),
-/// through a checkpoint and in a drape; it refuses to run without them, and a network without
-/// them refuses them.
+/// A network with body-contact features and the template-vertex input gets them from its
+/// batches (the features of `model::contact` on the body and M; the template), through a
+/// checkpoint and in a drape; it refuses to run without them, and a network without them
+/// refuses them.
 #[test]
 fn extended_network_takes_its_inputs_and_only_it() {
     let device = Device::flex();
     let (body, body_topo) = meshed_body();
     let cfg = GarNetConfig::tiny(Variant::Local)
         .with_body_contact(true)
-        .with_vertex_frames(true)
         .with_rest_input(true);
     let template = tube_garment(60);
     let setup = ModelSetup::new(cfg.clone(), template.clone(), &body).unwrap();
     assert!(setup.validate().is_err(), "no body faces");
     let setup = setup.with_body_faces(body_topo.faces.clone()).unwrap();
     let model = setup.config.init(&device).unwrap();
-    assert!(model.takes_contact() && model.vertex_frames && model.rest_input);
+    assert!(model.takes_contact() && model.rest_input);
     let sample = Sample::new(
         body.clone(),
         &body_topo,
@@ -138,7 +137,7 @@ fn extended_network_takes_its_inputs_and_only_it() {
     let topo_t = topo.to_device(&device);
     let batch = Batch::new(&[sample], &topo, &setup.input_spec(), &device).unwrap();
     let contact = batch.inputs.contact.clone().expect("contact features");
-    // M is the template, so the canonical frame and the rotations are the identity.
+    // M is the template, so the canonical frame is the identity.
     let normals = geom::normals::vertex_normals(&body, &body_topo.faces);
     let index = geom::KnnIndex::new(&body).unwrap();
     let want =
@@ -151,49 +150,38 @@ fn extended_network_takes_its_inputs_and_only_it() {
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f32::max);
     assert!(worst < 1e-3, "{worst}");
-    let rotations = model::tensors::read_f32(batch.inputs.rotations.clone().unwrap()).unwrap();
-    let identity = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
-    assert!(rotations
-        .chunks_exact(9)
-        .all(|r| r.iter().zip(identity).all(|(a, b)| (a - b).abs() < 1e-3)));
+    let rest = model::tensors::read_points(batch.inputs.rest.clone().unwrap()).unwrap();
+    assert_eq!(rest[0], template.vertices);
     let run =
         |m: &model::GarNet, inputs: &NetInputs| m.forward(inputs, batch.warped.clone(), &topo_t);
     let pred = model::tensors::read_points(run(&model, &batch.inputs).unwrap()).unwrap();
-    // Each extra input left out (bit 0 contact, 1 rotations, 2 template vertices).
+    // Each extra input left out (bit 0 contact, 1 template vertices).
     let without = |leave_out: u8| {
         let mut i = batch.inputs.clone();
         if leave_out & 1 != 0 {
             i.contact = None;
         }
         if leave_out & 2 != 0 {
-            i.rotations = None;
-        }
-        if leave_out & 4 != 0 {
             i.rest = None;
         }
         i
     };
-    let wants = [
-        "body-contact features",
-        "vertex rotations",
-        "template vertices",
-    ];
+    let wants = ["body-contact features", "template vertices"];
     let plain = cfg
         .with_body_contact(false)
-        .with_vertex_frames(false)
         .with_rest_input(false)
         .init(&device)
         .unwrap();
-    assert!(!plain.takes_contact() && !plain.vertex_frames && !plain.rest_input);
+    assert!(!plain.takes_contact() && !plain.rest_input);
     for (bit, what) in wants.iter().enumerate() {
         let err = run(&model, &without(1 << bit)).unwrap_err().to_string();
         assert!(err.contains(&format!("needs {what}")), "{err}");
-        let err = run(&plain, &without(7 & !(1 << bit)))
+        let err = run(&plain, &without(3 & !(1 << bit)))
             .unwrap_err()
             .to_string();
         assert!(err.contains(&format!("takes no {what}")), "{err}");
     }
-    assert!(run(&plain, &without(7)).is_ok());
+    assert!(run(&plain, &without(3)).is_ok());
     // Through a checkpoint: the faces come back and a drape computes the same inputs.
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("c.garnet");
