@@ -513,17 +513,19 @@ fn bench_model_reports_every_variant_against_the_dqs_warp() {
         "--simulator",
     ]);
     assert!(out.contains("DQS warp (reference)"), "{out}");
-    // A drape row and a training-step row each; GarNet-Local also on the simulator's drape,
-    // alone and with the push-out.
-    for (variant, count) in [("| local |", 4), ("| global |", 2), ("| naive |", 2)] {
+    // A drape row and a training-step row each; GarNet-Local, with and without the
+    // body-contact features, also on the simulator's drape, alone and with the push-out.
+    for (variant, count) in [("| local |", 6), ("| global |", 2), ("| naive |", 2)] {
         let rows = out.lines().filter(|l| l.contains(variant)).count();
         assert_eq!(rows, count, "{variant}\n{out}");
     }
     assert!(out.contains("same drape: simulator to rest"), "{out}");
-    assert!(
-        out.contains("same drape: GarNet-Local with the push-out"),
-        "{out}"
-    );
+    for name in ["GarNet-local", "GarNet-local +contact"] {
+        assert!(
+            out.contains(&format!("same drape: {name} with the push-out")),
+            "{out}"
+        );
+    }
     assert!(out.contains("with the push-out), "), "{out}");
     assert!(out.contains("faster than the simulator"), "{out}");
 }
