@@ -128,35 +128,26 @@ pub fn run(args: &CompareArgs) -> anyhow::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Vec3;
 
+    /// A unit square in the xz plane: faces [0,2,1] and [1,2,3], vertex 1 in both.
     fn square() -> TriMesh {
-        TriMesh::new(
-            vec![
-                Vec3::new(0.0, 0.0, 0.0),
-                Vec3::new(1.0, 0.0, 0.0),
-                Vec3::new(1.0, 1.0, 0.0),
-                Vec3::new(0.0, 1.0, 0.0),
-            ],
-            vec![[0, 1, 2], [0, 2, 3]],
-        )
+        TriMesh::grid(2, 2, 1.0)
     }
 
-    /// Hand-computed: moving one corner of a unit square 3 cm along z moves one vertex of
-    /// four (E_dist 0.75 cm) and tilts both faces that hold it by atan(0.03).
+    /// Hand-computed: lifting one corner of a unit square 3 cm out of its plane moves one
+    /// vertex of four (E_dist 0.75 cm) and tilts both faces, right-angled triangles with that
+    /// corner at the end of a unit leg, by atan(0.03).
     #[test]
     fn one_moved_corner_gives_the_hand_computed_errors() {
         let a = square();
         let mut b = square();
-        b.vertices[2].z = 0.03;
+        b.vertices[1].y = 0.03;
         let c = Comparison::measure(&a, &b).unwrap();
         assert!((c.e_dist_cm - 0.75).abs() < 1e-5, "{c:?}");
         assert!((c.dist_max_cm - 3.0).abs() < 1e-5);
         assert_eq!(c.dist_p50_cm, 0.0);
         assert_eq!(c.within_1cm_pct, 75.0);
         assert_eq!(c.within_2cm_pct, 75.0);
-        // Face [0,1,2]'s normal becomes (0, -0.03, 1), face [0,2,3]'s (-0.03, 0, 1): both
-        // tilt by atan(0.03) from z.
         let tilt = 0.03f32.atan().to_degrees();
         assert!(
             (c.e_norm_deg - tilt).abs() < 1e-3,
@@ -175,7 +166,7 @@ mod tests {
         let e = Comparison::measure(&a, &fewer).unwrap_err().to_string();
         assert!(e.contains("not the same garment mesh"), "{e}");
         let mut flipped = square();
-        flipped.faces[1] = [0, 3, 2];
+        flipped.faces[1] = [1, 3, 2];
         assert!(Comparison::measure(&a, &flipped).is_err());
         let mut nan = square();
         nan.vertices[1].x = f32::NAN;

@@ -93,6 +93,19 @@ fn local_variant_needs_its_tables() {
     assert!(err.to_string().contains("local tables"), "{err}");
 }
 
+/// Saves `model` with `setup`, the default loss and a fresh training state, no optimiser.
+fn save_without_optimizer(path: &std::path::Path, model: &GarNet, setup: &ModelSetup) {
+    save_checkpoint(
+        path,
+        model,
+        None,
+        setup,
+        &LossConfig::new(),
+        &TrainState::default(),
+    )
+    .unwrap();
+}
+
 /// A closed ellipsoid body with faces (an icosphere, 642 vertices) and its topology.
 fn meshed_body() -> (Vec<Vec3>, BodyTopology) {
     use model::synthetic::{BODY_CENTRE, BODY_RADII};
@@ -185,15 +198,7 @@ fn extended_network_takes_its_inputs_and_only_it() {
     // Through a checkpoint: the faces come back and a drape computes the same inputs.
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("c.garnet");
-    save_checkpoint(
-        &path,
-        &model,
-        None,
-        &setup,
-        &LossConfig::new(),
-        &TrainState::default(),
-    )
-    .unwrap();
+    save_without_optimizer(&path, &model, &setup);
     let ck = load_checkpoint(&path).unwrap();
     assert_eq!(ck.setup.body_faces.as_ref(), Some(&body_topo.faces));
     let draper = Draper::load(&path, &device).unwrap();
@@ -394,15 +399,7 @@ fn corrupt_or_foreign_checkpoints_are_clear_errors() {
     let s = setup(Variant::Global, 60);
     let path = dir.path().join("g.garnet");
     let model = s.config.init(&device).unwrap();
-    save_checkpoint(
-        &path,
-        &model,
-        None,
-        &s,
-        &LossConfig::new(),
-        &TrainState::default(),
-    )
-    .unwrap();
+    save_without_optimizer(&path, &model, &s);
     let mut ck = load_checkpoint(&path).unwrap();
     assert!(!ck.has_optimizer());
     ck.setup.config = ck.setup.config.clone().with_conv_width(24);
