@@ -415,12 +415,14 @@ fn drape_and_eval_refuse_what_does_not_fit() {
 fn train_takes_the_network_widths_from_a_config_file() {
     let data = dataset();
     let tmp = tempfile::tempdir().unwrap();
+    // The run's header: "training GarNet-naive[ +extensions] (N parameters) on ...".
     let params = |log: &str| -> usize {
         let after = log
-            .split("training GarNet-naive (")
+            .split("training GarNet-naive")
             .nth(1)
             .expect("the run's header");
-        after.split(' ').next().unwrap().parse().unwrap()
+        let count = after.split('(').nth(1).expect("a parameter count");
+        count.split(' ').next().unwrap().parse().unwrap()
     };
     let run = |name: &str, extra: &[&str]| {
         let out = tmp.path().join(name);
@@ -430,10 +432,18 @@ fn train_takes_the_network_widths_from_a_config_file() {
     };
     let default = params(&ok(&as_str(&run("default", &[]))));
     let config = tmp.path().join("narrow.json");
-    std::fs::write(&config, r#"{"fusion": [16, 8], "variant": "Local"}"#).unwrap();
+    std::fs::write(
+        &config,
+        r#"{"fusion": [16, 8], "variant": "Local", "body_contact": true, "rest_input": true}"#,
+    )
+    .unwrap();
     let log = ok(&as_str(&run("narrow", &["--config", s(&config)])));
-    // The file's fusion widths, the command line's variant: fewer parameters than the
-    // default Naive, still a Naive network.
+    // The file's fusion widths and extra inputs, the command line's variant: fewer
+    // parameters than the default Naive, still a Naive network, named with its extensions.
+    assert!(
+        log.contains("training GarNet-naive +contact +rest ("),
+        "{log}"
+    );
     assert!(params(&log) < default, "{log}");
     let naive = tmp.path().join("narrow/best.garnet");
     ok(&[
@@ -447,6 +457,23 @@ fn train_takes_the_network_widths_from_a_config_file() {
         "--out",
         s(&tmp.path().join("eval")),
     ]);
+    let table = std::fs::read_to_string(tmp.path().join("eval/results.md")).unwrap();
+    assert!(table.contains("| GarNet-naive +contact +rest |"), "{table}");
+    // The model carries the body's faces, so a drape computes the contact features itself.
+    let out = ok(&[
+        "drape",
+        "--model",
+        s(&naive),
+        "--random-shape",
+        "2",
+        "--pose-procedural",
+        "3",
+        "--out",
+        s(&tmp.path().join("d.glb")),
+    ]);
+    assert!(out.contains("GarNet-naive +contact +rest"), "{out}");
+    let draped = geom::io::read_mesh(tmp.path().join("d.glb")).unwrap();
+    assert!(draped.vertices.iter().all(|v| v.is_finite()));
     // An unknown field or a wrong type names the file and the field.
     std::fs::write(&config, r#"{"fusion_widths": [16]}"#).unwrap();
     let err = fails(&as_str(&run("bad", &["--config", s(&config)])));
