@@ -149,10 +149,13 @@ impl InputSpec {
 
     /// The network inputs of B samples: stream points `[B][P]` of `bodies` `[B][V]`, and the
     /// local tables and the contact features `[B,N,CONTACT_WIDTH]` of them and `warped`
-    /// `[B][N]` (metres, one frame) when the spec has them.
+    /// `[B][N]` (metres, one frame) when the spec has them. The contact features take the
+    /// bodies' unit outward vertex normals `normals` `[B][V]` when given (a mirrored sample's
+    /// faces wind inwards), else compute them from the spec's faces.
     pub fn inputs(
         &self,
         bodies: &[&[Vec3]],
+        normals: Option<&[&[Vec3]]>,
         warped: &[&[Vec3]],
         device: &Device,
     ) -> Result<NetInputs> {
@@ -175,11 +178,18 @@ impl InputSpec {
         let contact = match &self.contact_faces {
             Some(faces) => {
                 let mut flat = Vec::new();
-                for (body, m) in bodies.iter().zip(warped) {
-                    geom::adjacency::check_indices(body.len(), faces)?;
-                    let normals = geom::normals::vertex_normals(body, faces);
+                for (b, (body, m)) in bodies.iter().zip(warped).enumerate() {
+                    let own;
+                    let body_normals = match normals.and_then(|n| n.get(b)) {
+                        Some(n) => *n,
+                        None => {
+                            geom::adjacency::check_indices(body.len(), faces)?;
+                            own = geom::normals::vertex_normals(body, faces);
+                            &own
+                        }
+                    };
                     let index = geom::KnnIndex::new(body)?;
-                    flat.extend(contact_features(&index, body, &normals, m)?);
+                    flat.extend(contact_features(&index, body, body_normals, m)?);
                 }
                 let n = warped.first().map_or(0, |m| m.len());
                 Some(vec_tensor(flat, [warped.len(), n, CONTACT_WIDTH], device))
@@ -310,7 +320,7 @@ impl Batch {
         let bodies: Vec<&[Vec3]> = bodies.iter().map(Vec::as_slice).collect();
         let normals: Vec<&[Vec3]> = normals.iter().map(Vec::as_slice).collect();
         let warped: Vec<&[Vec3]> = warped.iter().map(Vec::as_slice).collect();
-        let inputs = spec.inputs(&bodies, &warped, device)?;
+        let inputs = spec.inputs(&bodies, Some(&normals), &warped, device)?;
         let (target, target_points, body_index) = if with_target {
             let targets: Vec<&[Vec3]> = targets.iter().map(Vec::as_slice).collect();
             let index = bodies

@@ -118,7 +118,7 @@ impl Draper {
         let (frames, bodies, warped) = self.spec.to_canonical(items);
         let bodies: Vec<&[Vec3]> = bodies.iter().map(Vec::as_slice).collect();
         let warped: Vec<&[Vec3]> = warped.iter().map(Vec::as_slice).collect();
-        let inputs = self.spec.inputs(&bodies, &warped, &self.device)?;
+        let inputs = self.spec.inputs(&bodies, None, &warped, &self.device)?;
         let pred = self
             .model
             .forward(&inputs, points_tensor(&warped, &self.device), &self.topo)?;

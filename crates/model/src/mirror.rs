@@ -259,5 +259,20 @@ mod tests {
             assert!((w.distance(*t) - 0.01).abs() < 1e-4);
         }
         assert_eq!(m.body_edge, sample.body_edge);
+        // Regression: the contact features of the mirrored sample take its carried normals,
+        // so its garment, 2 cm outside the body, is 2 cm outside (it was 2 cm inside when
+        // they were recomputed from the inward-wound faces).
+        let spec = InputSpec {
+            contact_faces: Some(faces.clone()),
+            ..spec
+        };
+        let topology =
+            crate::topology::GarmentTopology::from_mesh(&TriMesh::new(garment, faces)).unwrap();
+        let device = burn::prelude::Device::flex();
+        let batch = crate::batch::Batch::new(&[m], &topology, &spec, &device).unwrap();
+        let contact = crate::tensors::read_f32(batch.inputs.contact.unwrap()).unwrap();
+        for row in contact.chunks_exact(crate::contact::CONTACT_WIDTH) {
+            assert!((row[6] - 2.0).abs() < 0.2, "signed distance {} cm", row[6]);
+        }
     }
 }
