@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context};
 use clap::Args;
-use geom::metrics::{face_normal_angles, m_to_cm, rad_to_deg, vertex_distances};
+use geom::metrics::{m_to_cm, mesh_errors, precision_curve, vertex_distances};
 use geom::TriMesh;
 use serde::Serialize;
 use sim::stats::percentile;
@@ -68,24 +68,19 @@ impl Comparison {
                 other.faces.len()
             );
         }
+        let errors = mesh_errors(&reference.vertices, &other.vertices, &reference.faces)?;
         let dist = vertex_distances(&reference.vertices, &other.vertices)?;
-        let angles = face_normal_angles(&reference.vertices, &other.vertices, &reference.faces)?;
-        let n = dist.len().max(1) as f64;
-        let share_within = |cm: f32| {
-            (dist.iter().filter(|&&d| m_to_cm(d) <= cm).count() as f64 / n * 100.0) as f32
-        };
-        let mean =
-            |v: &[f32]| (v.iter().map(|&x| x as f64).sum::<f64>() / v.len().max(1) as f64) as f32;
+        let within = precision_curve(&dist, &[0.01, 0.02]);
         Ok(Comparison {
             vertices: dist.len(),
-            faces: angles.len(),
-            e_dist_cm: m_to_cm(mean(&dist)),
+            faces: reference.faces.len(),
+            e_dist_cm: errors.e_dist_cm,
             dist_p50_cm: m_to_cm(percentile(&dist, 0.5)),
             dist_p90_cm: m_to_cm(percentile(&dist, 0.9)),
             dist_max_cm: m_to_cm(dist.iter().copied().fold(0.0, f32::max)),
-            e_norm_deg: rad_to_deg(mean(&angles)),
-            within_1cm_pct: share_within(1.0),
-            within_2cm_pct: share_within(2.0),
+            e_norm_deg: errors.e_norm_deg,
+            within_1cm_pct: within[0] * 100.0,
+            within_2cm_pct: within[1] * 100.0,
         })
     }
 }

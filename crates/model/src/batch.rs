@@ -149,13 +149,13 @@ impl InputSpec {
 
     /// The network inputs of B samples: stream points `[B][P]` of `bodies` `[B][V]`, and the
     /// local tables and the contact features `[B,N,CONTACT_WIDTH]` of them and `warped`
-    /// `[B][N]` (metres, one frame) when the spec has them. The contact features take the
-    /// bodies' unit outward vertex normals `normals` `[B][V]` when given (a mirrored sample's
-    /// faces wind inwards), else compute them from the spec's faces.
+    /// `[B][N]` (metres, one frame) when the spec has them. The contact features take what
+    /// the caller already has of the bodies (`known`: their normals, as a mirrored sample's
+    /// faces wind inwards, and k-d trees), else compute it from the spec's faces.
     pub fn inputs(
         &self,
         bodies: &[&[Vec3]],
-        normals: Option<&[&[Vec3]]>,
+        known: Option<KnownBodies>,
         warped: &[&[Vec3]],
         device: &Device,
     ) -> Result<NetInputs> {
@@ -179,17 +179,15 @@ impl InputSpec {
             Some(faces) => {
                 let mut flat = Vec::new();
                 for (b, (body, m)) in bodies.iter().zip(warped).enumerate() {
-                    let own;
-                    let body_normals = match normals.and_then(|n| n.get(b)) {
-                        Some(n) => *n,
+                    let features = match &known {
+                        Some(k) => contact_features(&k.index[b], body, k.normals[b], m)?,
                         None => {
                             geom::adjacency::check_indices(body.len(), faces)?;
-                            own = geom::normals::vertex_normals(body, faces);
-                            &own
+                            let normals = geom::normals::vertex_normals(body, faces);
+                            contact_features(&geom::KnnIndex::new(body)?, body, &normals, m)?
                         }
                     };
-                    let index = geom::KnnIndex::new(body)?;
-                    flat.extend(contact_features(&index, body, body_normals, m)?);
+                    flat.extend(features);
                 }
                 let n = warped.first().map_or(0, |m| m.len());
                 Some(vec_tensor(flat, [warped.len(), n, CONTACT_WIDTH], device))
@@ -207,6 +205,15 @@ impl InputSpec {
             rest,
         })
     }
+}
+
+/// What a caller of [`InputSpec::inputs`] already has of its B bodies.
+#[derive(Clone, Copy)]
+pub struct KnownBodies<'a> {
+    /// Unit outward vertex normals `[B][V]`.
+    pub normals: &'a [&'a [Vec3]],
+    /// k-d trees over the body vertices `[B]`.
+    pub index: &'a [Arc<geom::KnnIndex>],
 }
 
 /// What [`InputSpec::inputs`] makes of B samples besides M: the network's inputs (see
@@ -246,7 +253,8 @@ pub struct Batch {
     /// Target garment G `[B,N,3]`, metres (present when every sample has one).
     pub target: Option<Tensor<3>>,
     /// Per-sample k-d trees over the body vertices (the penetration loss's nearest-vertex
-    /// search), built with the batch when it has targets.
+    /// search, and the contact features'), built with the batch when it has targets or the
+    /// network takes contact features.
     pub(crate) body_index: Vec<Arc<geom::KnnIndex>>,
     /// Targets on the CPU `[B][N]`, canonical frame (the penetration mask and the metrics).
     pub(crate) target_points: Option<Vec<Vec<Vec3>>>,
@@ -320,20 +328,27 @@ impl Batch {
         let bodies: Vec<&[Vec3]> = bodies.iter().map(Vec::as_slice).collect();
         let normals: Vec<&[Vec3]> = normals.iter().map(Vec::as_slice).collect();
         let warped: Vec<&[Vec3]> = warped.iter().map(Vec::as_slice).collect();
-        let inputs = spec.inputs(&bodies, Some(&normals), &warped, device)?;
-        let (target, target_points, body_index) = if with_target {
-            let targets: Vec<&[Vec3]> = targets.iter().map(Vec::as_slice).collect();
-            let index = bodies
+        let body_index = if with_target || spec.contact_faces.is_some() {
+            bodies
                 .iter()
                 .map(|b| geom::KnnIndex::new(b).map(Arc::new))
-                .collect::<std::result::Result<Vec<_>, _>>()?;
+                .collect::<std::result::Result<Vec<_>, _>>()?
+        } else {
+            Vec::new()
+        };
+        let known = KnownBodies {
+            normals: &normals,
+            index: &body_index,
+        };
+        let inputs = spec.inputs(&bodies, Some(known), &warped, device)?;
+        let (target, target_points) = if with_target {
+            let targets: Vec<&[Vec3]> = targets.iter().map(Vec::as_slice).collect();
             (
                 Some(points_tensor(&targets, device)),
                 Some(targets.iter().map(|t| t.to_vec()).collect()),
-                index,
             )
         } else {
-            (None, None, Vec::new())
+            (None, None)
         };
         Ok(Batch {
             size: samples.len(),

@@ -87,7 +87,7 @@ impl GarNet {
     /// - `inputs`: the body points the stream sees `[B,P,3]` (see
     ///   [`crate::local::BodySampling::stream_points`]), metres; the neighbour tables,
     ///   required by GarNet-Local; the body-contact features of M `[B,N,CONTACT_WIDTH]` (see
-    ///   [`crate::contact`]), required by a network that [`GarNet::takes_contact`] and refused
+    ///   [`crate::contact`]), required by a network with [`GarNet::body_contact`] and refused
     ///   by the others; the template's vertices `[B,N,3]` (metres), likewise with
     ///   [`GarNet::rest_input`].
     /// - `warped`: the DQS-warped garment M `[B,N,3]`, metres.
@@ -99,7 +99,7 @@ impl GarNet {
         topo: &TopologyTensors,
     ) -> Result<Tensor<3>> {
         let body = inputs.body_stream.clone();
-        let (local, contact) = (inputs.local.as_ref(), inputs.contact.clone());
+        let local = inputs.local.as_ref();
         let [b, v, cb] = body.dims();
         let [bm, n, cm] = warped.dims();
         if cb != 3 || cm != 3 || b != bm || b == 0 || v == 0 {
@@ -115,26 +115,23 @@ impl GarNet {
                 got: n,
             });
         }
-        match &contact {
-            Some(c) if self.takes_contact() && c.dims() == [b, n, CONTACT_WIDTH] => {}
-            None if !self.takes_contact() => {}
-            _ => {
+        let extras = [
+            (
+                &inputs.contact,
+                self.body_contact,
+                CONTACT_WIDTH,
+                "body-contact features",
+            ),
+            (&inputs.rest, self.rest_input, 3, "template vertices"),
+        ];
+        for (given, wanted, width, what) in extras {
+            if given.as_ref().map(|t| t.dims()) != wanted.then_some([b, n, width]) {
                 return Err(ModelError::InvalidInput(format!(
-                    "this network {} body-contact features [{b},{n},{CONTACT_WIDTH}], got {:?}",
-                    if self.takes_contact() {
-                        "needs"
-                    } else {
-                        "takes no"
-                    },
-                    contact.as_ref().map(|c| c.dims())
-                )))
+                    "this network {} {what} [{b},{n},{width}], got {:?}",
+                    if wanted { "needs" } else { "takes no" },
+                    given.as_ref().map(|t| t.dims())
+                )));
             }
-        }
-        if inputs.rest.as_ref().map(|r| r.dims()) != self.rest_input.then_some([b, n, 3]) {
-            return Err(ModelError::InvalidInput(format!(
-                "this network {} template vertices [{b},{n},3]",
-                if self.rest_input { "needs" } else { "takes no" }
-            )));
         }
         let centre = Tensor::<1>::from_floats(self.input_centre.as_slice(), &body.device())
             .reshape([1, 1, 3]);
@@ -145,7 +142,7 @@ impl GarNet {
         if let Some(r) = &inputs.rest {
             extra.push((r.clone() - centre) / unit);
         }
-        extra.extend(contact);
+        extra.extend(inputs.contact.clone());
         let body_features = self.body.forward(body);
         let garment = self
             .garment
@@ -178,12 +175,6 @@ impl GarNet {
         };
         let global = Tensor::cat(vec![garment.global, body_features.global], 1);
         Ok(self.fusion.forward(per_vertex, global) * unit)
-    }
-
-    /// Whether the network takes body-contact features (its config had
-    /// [`GarNetConfig::body_contact`]).
-    pub fn takes_contact(&self) -> bool {
-        self.body_contact
     }
 
     /// The predicted draped garment `G = M + T` `[B,N,3]` (metres); arguments as

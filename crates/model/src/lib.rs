@@ -63,7 +63,7 @@ pub mod train;
 pub mod trainer;
 
 pub use alloc::tune_allocator;
-pub use batch::{Batch, BodyTopology, InputSpec, NetInputs, Sample};
+pub use batch::{Batch, BodyTopology, InputSpec, KnownBodies, NetInputs, Sample};
 pub use checkpoint::{load_checkpoint, save_checkpoint, Checkpoint, ModelSetup, TrainState};
 pub use config::{GarNetConfig, Variant};
 pub use drape::Draper;

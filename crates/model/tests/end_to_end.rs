@@ -135,7 +135,7 @@ fn extended_network_takes_its_inputs_and_only_it() {
     assert!(setup.validate().is_err(), "no body faces");
     let setup = setup.with_body_faces(body_topo.faces.clone()).unwrap();
     let model = setup.config.init(&device).unwrap();
-    assert!(model.takes_contact() && model.rest_input);
+    assert!(model.body_contact && model.rest_input);
     let sample = Sample::new(
         body.clone(),
         &body_topo,
@@ -185,7 +185,7 @@ fn extended_network_takes_its_inputs_and_only_it() {
         .with_rest_input(false)
         .init(&device)
         .unwrap();
-    assert!(!plain.takes_contact() && !plain.rest_input);
+    assert!(!plain.body_contact && !plain.rest_input);
     for (bit, what) in wants.iter().enumerate() {
         let err = run(&model, &without(1 << bit)).unwrap_err().to_string();
         assert!(err.contains(&format!("needs {what}")), "{err}");
