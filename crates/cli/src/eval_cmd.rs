@@ -22,6 +22,7 @@ use serde::Serialize;
 use crate::drape_cmd::{checkpoint_template, push_out_gap, PUSH_OUT_WITHIN};
 use crate::drape_filter_args::{keep_drapes, DrapeFilterArgs};
 use crate::eval_motion::{ByMotion, MotionRow};
+use crate::eval_save::{save_folders, DrapeSaver, SavedDrape};
 use crate::model_device::DeviceArg;
 use crate::simulate_cmd::write_json;
 
@@ -54,6 +55,21 @@ pub struct EvalArgs {
     /// out" (the paper's Table 1 has the network's raw output only).
     #[arg(long)]
     pub push_out: bool,
+    /// Also write every evaluated drape (the network's, the simulator's, the warped M and
+    /// the body, PLY in metres) and a table of each drape's errors, `samples.csv`, into
+    /// `DIR/MODEL/` for each model file `MODEL.garnet` (`DIR/PARENT-MODEL/` where file names
+    /// repeat).
+    #[arg(long, value_name = "DIR")]
+    pub save_drapes: Option<PathBuf>,
+}
+
+/// What [`EvalData::evaluate`] makes besides the network's and the DQS warp's rows.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EvalOutputs<'a> {
+    /// Also the network's drapes pushed out of the body as `garnet drape` does.
+    pub push_out: bool,
+    /// Write every drape and its errors into this folder (see [`crate::eval_save`]).
+    pub save_drapes: Option<&'a Path>,
 }
 
 /// One row of Table 1 and its curves.
@@ -129,6 +145,11 @@ impl Errors {
         self.dists_cm.extend(d);
         self.angles_deg.extend(a);
         Ok(mean_dist)
+    }
+
+    /// E_norm (degrees) of the drape added last (0 before any).
+    fn last_norm_deg(&self) -> f32 {
+        self.sample_norm.last().copied().unwrap_or(0.0)
     }
 
     fn row(&self, garment: &str, method: &str) -> Row {
@@ -234,15 +255,14 @@ impl EvalData {
     }
 
     /// Evaluates the model at `path` on `split` (the drapes `filter` keeps, when given; at
-    /// most `max_samples` samples of its garment); with `push_out`, also its drapes pushed
-    /// out of the body as `garnet drape` does by default.
+    /// most `max_samples` samples of its garment), with the extra `outputs`.
     pub fn evaluate(
         &self,
         path: &Path,
         split: &str,
         filter: Option<&DrapeFilter>,
         max_samples: Option<usize>,
-        push_out: bool,
+        outputs: EvalOutputs,
         device: &burn::prelude::Device,
     ) -> anyhow::Result<ModelEvaluation> {
         let data = &self.data;
@@ -268,6 +288,11 @@ impl EvalData {
         let (mut net, mut pushed, mut dqs) =
             (Errors::default(), Errors::default(), Errors::default());
         let mut by_motion = ByMotion::default();
+        let mut saver = outputs
+            .save_drapes
+            .map(|dir| DrapeSaver::new(dir, faces, &self.body_faces))
+            .transpose()?;
+        let push_out = outputs.push_out;
         let (mut net_ms, mut dqs_ms, mut sim_s) = (Vec::new(), Vec::new(), Vec::new());
         let opts = BatchOptions {
             batch_size: 1,
@@ -303,13 +328,28 @@ impl EvalData {
                     }
                 };
                 let net_cm = net.add(&a.draped, &pred, faces, body)?;
+                let dqs_cm = dqs.add(&a.draped, &a.warped, faces, body)?;
+                if let Some(saver) = &mut saver {
+                    saver.save(&SavedDrape {
+                        index: s.record.index,
+                        pose: &s.record.pose,
+                        body: &a.body,
+                        sim: &a.draped,
+                        dqs: &a.warped,
+                        net: &pred,
+                        errors: [net_cm, net.last_norm_deg(), dqs_cm],
+                    })?;
+                }
                 if let Some(c) = &collider {
                     c.push_out(&mut pred, PUSH_OUT_WITHIN, push_out_gap());
                     pushed.add(&a.draped, &pred, faces, body)?;
                 }
-                let dqs_cm = dqs.add(&a.draped, &a.warped, faces, body)?;
                 by_motion.add(&s.record.pose, net_cm, dqs_cm);
             }
+        }
+        if let Some(saver) = saver {
+            let dir = saver.finish()?;
+            eprintln!("drapes and their errors written to {}", dir.display());
         }
         Ok(ModelEvaluation {
             by_motion: by_motion.rows(&garment, &method),
@@ -338,13 +378,20 @@ pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
     let mut timings: Vec<Timing> = Vec::new();
     let mut motions: Vec<MotionRow> = Vec::new();
     let mut dqs_done: BTreeSet<String> = BTreeSet::new();
-    for path in &args.models {
+    let save_dirs = args
+        .save_drapes
+        .as_ref()
+        .map(|root| save_folders(root, &args.models));
+    for (i, path) in args.models.iter().enumerate() {
         let e = data.evaluate(
             path,
             &args.split,
             filter.as_ref(),
             args.max_samples,
-            args.push_out,
+            EvalOutputs {
+                push_out: args.push_out,
+                save_drapes: save_dirs.as_ref().map(|d| d[i].as_path()),
+            },
             &device,
         )?;
         rows.push(e.net);

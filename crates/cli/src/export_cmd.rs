@@ -14,7 +14,7 @@ use model::{load_checkpoint, save_checkpoint, Checkpoint};
 use dataset::{Dataset, DrapeFilter};
 
 use crate::drape_filter_args::{filter_flags, DrapeFilterArgs};
-use crate::eval_cmd::{EvalData, ModelEvaluation};
+use crate::eval_cmd::{EvalData, EvalOutputs, ModelEvaluation};
 use crate::model_device::DeviceArg;
 
 /// Arguments of `garnet export`.
@@ -87,7 +87,7 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
         &args.split,
         None,
         args.max_samples,
-        false,
+        EvalOutputs::default(),
         &device,
     )?;
     let filtered = filter
@@ -97,7 +97,7 @@ pub fn run(args: &ExportArgs) -> anyhow::Result<()> {
                 &args.split,
                 Some(&f),
                 args.max_samples,
-                false,
+                EvalOutputs::default(),
                 &device,
             )
             .map(|e| (f, e))

@@ -11,6 +11,7 @@ mod drape_cmd;
 mod drape_filter_args;
 mod eval_cmd;
 mod eval_motion;
+mod eval_save;
 mod export_cmd;
 mod garment_cmd;
 mod garment_sheet;

@@ -133,6 +133,8 @@ fn train_resume_eval_and_drape() {
         "--out",
         s(&eval),
         "--push-out",
+        "--save-drapes",
+        s(&eval.join("drapes")),
     ]);
     for row in [
         "GarNet-local",
@@ -153,6 +155,7 @@ fn train_resume_eval_and_drape() {
     ] {
         assert!(eval.join(f).is_file(), "{f}");
     }
+    check_saved_drapes(&eval.join("drapes").join("local-best"), &report);
 
     // Export: the network without the optimiser state, and its model card.
     let shipped = tmp.path().join("models").join("tshirt-local.garnet");
@@ -409,6 +412,46 @@ fn drape_and_eval_refuse_what_does_not_fit() {
     ]);
     assert!(err.contains("separate runs"), "{err}");
     assert!(!tmp.path().join("x-tshirt.obj").exists());
+}
+
+/// `eval --save-drapes`: each row of `samples.csv` has its four meshes, and its errors are
+/// the paper's metrics of the saved network and simulator drapes; `report` is Table 1's
+/// markdown, whose GarNet-local E_dist is their mean.
+fn check_saved_drapes(dir: &Path, report: &str) {
+    let csv = std::fs::read_to_string(dir.join("samples.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some("index,pose,e_dist_cm,e_norm_deg,dqs_e_dist_cm")
+    );
+    let mut dists = Vec::new();
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        let mesh = |what: &str| {
+            geom::io::read_mesh(dir.join(format!("{:06}-{what}.ply", f[0].parse::<u64>().unwrap())))
+                .unwrap()
+        };
+        let (net, sim, dqs) = (mesh("net"), mesh("sim"), mesh("dqs"));
+        assert_eq!(mesh("body").faces.len(), 26756);
+        let e = geom::metrics::mesh_errors(&sim.vertices, &net.vertices, &sim.faces).unwrap();
+        let d = geom::metrics::mesh_errors(&sim.vertices, &dqs.vertices, &sim.faces).unwrap();
+        let col = |i: usize| f[i].parse::<f32>().unwrap();
+        assert!((col(2) - e.e_dist_cm).abs() < 1e-3, "{line}: {e:?}");
+        assert!((col(3) - e.e_norm_deg).abs() < 1e-2, "{line}: {e:?}");
+        assert!((col(4) - d.e_dist_cm).abs() < 1e-3, "{line}: {d:?}");
+        assert!(f[1].contains("walk"), "{line}");
+        dists.push(col(2));
+    }
+    assert_eq!(dists.len(), 2, "{csv}");
+    let mean = dists.iter().sum::<f32>() / 2.0;
+    let table: f32 = report
+        .lines()
+        .find_map(|l| l.strip_prefix("| tshirt | GarNet-local | 2 | "))
+        .and_then(|rest| rest.split(" |").next())
+        .unwrap_or_else(|| panic!("no GarNet-local row of 2 samples:\n{report}"))
+        .parse()
+        .unwrap();
+    assert!((table - mean).abs() < 2e-3, "{table} against {mean}");
 }
 
 #[test]
