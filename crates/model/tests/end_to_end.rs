@@ -106,6 +106,68 @@ fn save_without_optimizer(path: &std::path::Path, model: &GarNet, setup: &ModelS
     .unwrap();
 }
 
+/// Rewrites the checkpoint at `path` as a file from before the later metadata existed:
+/// `drop_meta` keys left out of its metadata, `drop_config` out of its config and
+/// `drop_loss` out of its loss (the safetensors header is JSON after its 8-byte length).
+fn strip_checkpoint(
+    path: &std::path::Path,
+    drop_meta: &[&str],
+    drop_config: &[&str],
+    drop_loss: &[&str],
+) {
+    let bytes = std::fs::read(path).unwrap();
+    let n = u64::from_le_bytes(bytes[..8].try_into().unwrap()) as usize;
+    let mut header: serde_json::Value = serde_json::from_slice(&bytes[8..8 + n]).unwrap();
+    let meta = header["__metadata__"].as_object_mut().unwrap();
+    for key in drop_meta {
+        assert!(meta.remove(*key).is_some(), "{key}");
+    }
+    for (field, drop) in [("config", drop_config), ("loss", drop_loss)] {
+        let mut v: serde_json::Value = serde_json::from_str(meta[field].as_str().unwrap()).unwrap();
+        for key in drop {
+            assert!(v.as_object_mut().unwrap().remove(*key).is_some(), "{key}");
+        }
+        meta[field] = serde_json::Value::String(v.to_string());
+    }
+    let mut head = serde_json::to_vec(&header).unwrap();
+    head.resize(head.len().div_ceil(8) * 8, b' ');
+    let mut out = (head.len() as u64).to_le_bytes().to_vec();
+    out.extend(head);
+    out.extend_from_slice(&bytes[8 + n..]);
+    std::fs::write(path, out).unwrap();
+}
+
+/// Checkpoints written before a field existed load with what they were trained with:
+/// positions in metres (input unit 1, centre 0), loss in metres, no extra inputs, no
+/// canonical frame, DQS bodies.
+#[test]
+fn checkpoints_from_before_later_fields_load_as_they_were_trained() {
+    let device = Device::flex();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("old.garnet");
+    let s = setup(Variant::Naive, 60).with_body_skinning("lbs").unwrap();
+    let model = s.config.init(&device).unwrap();
+    save_without_optimizer(&path, &model, &s);
+    let fresh = load_checkpoint(&path).unwrap();
+    assert_eq!(fresh.setup.body_skinning, "lbs");
+    assert!(fresh.setup.canonical_frame);
+    strip_checkpoint(
+        &path,
+        &["body.skinning", "canonical_frame"],
+        &["input_scale", "input_centre", "rest_input", "body_contact"],
+        &["units_per_metre"],
+    );
+    let old = load_checkpoint(&path).unwrap();
+    assert_eq!(old.setup.body_skinning, "dqs");
+    assert!(!old.setup.canonical_frame);
+    let c = &old.setup.config;
+    assert_eq!((c.input_scale, c.input_centre.clone()), (1.0, vec![0.0; 3]));
+    assert!(!c.rest_input && !c.body_contact);
+    assert_eq!(old.loss.units_per_metre, 1.0);
+    // The parameters are the same; only their meaning changed.
+    assert_eq!(old.model(&device).unwrap().num_params(), model.num_params());
+}
+
 /// A closed ellipsoid body with faces (an icosphere, 642 vertices) and its topology.
 fn meshed_body() -> (Vec<Vec3>, BodyTopology) {
     use model::synthetic::{BODY_CENTRE, BODY_RADII};
@@ -404,17 +466,10 @@ fn corrupt_or_foreign_checkpoints_are_clear_errors() {
     assert!(!ck.has_optimizer());
     ck.setup.config = ck.setup.config.clone().with_conv_width(24);
     assert!(ck.model(&device).is_err());
-    // A skinning the body model does not have; a checkpoint from before the skinning was
-    // recorded (the shipped models) learned from DQS bodies.
+    // A skinning the body model does not have.
     assert!(setup(Variant::Global, 60)
         .with_body_skinning("cubic")
         .is_err());
-    let shipped =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/tshirt-naive.garnet");
-    assert_eq!(
-        load_checkpoint(&shipped).unwrap().setup.body_skinning,
-        "dqs"
-    );
     // A network saved with a setup of another variant.
     let local = setup(Variant::Local, 60);
     assert!(save_checkpoint(
