@@ -163,12 +163,12 @@ fn model_card(
     let [net, dqs] = eval.summary();
     let (net_ms, sim_s) = eval.times();
     let mut md = format!(
-        "# Model card: GarNet-{variant} for the {garment}\n\n\
+        "# Model card: {method} for the {garment}\n\n\
          `{name}` ({size_mb:.1} MB): the network ({params} parameters), the garment template it \
          drapes ({n} vertices, {f} faces, carried in the file with its skinning weights) and \
          the body points it sees ({p} of the body's {v} vertices). `garnet drape --model \
          {name} [shape] [pose]` needs nothing else.\n\n",
-        variant = cfg.variant.name(),
+        method = cfg.method_name(),
         garment = eval.garment,
         n = setup.template.vertices.len(),
         f = setup.template.faces.len(),
