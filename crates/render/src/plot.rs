@@ -97,25 +97,44 @@ impl Chart {
             INK,
         );
         draw_text(&mut img, 4, top - 14, &self.y_label, 1, INK);
+        let mut ink = Vec::new();
         for s in series {
             for pair in s.points.windows(2) {
                 let (a, b) = (to_px(pair[0].0, pair[0].1), to_px(pair[1].0, pair[1].1));
-                line(&mut img, a, b, s.color);
+                ink.extend(line(&mut img, a, b, s.color));
             }
         }
-        // The legend on a paper box in the top right corner, as wide as its longest name.
+        // The legend on a paper box as wide as its longest name, in the corner of the plot
+        // its curves cross least (top right when none does).
         let name_w = series
             .iter()
             .map(|s| text_size(&s.name, 1).0 as i64)
             .max()
             .unwrap_or(0);
-        let x = (left + pw - name_w - LEGEND_PAD).max(left + 4);
+        let (box_w, box_h) = (name_w + LEGEND_PAD, 14 * series.len() as i64 + 6);
+        let (x_right, x_left) = ((left + pw - box_w - 4).max(left + 2), left + 6);
+        let (y_top, y_bottom) = (top + 6, (top + ph - box_h - 6).max(top + 6));
+        let corners = [
+            (x_right, y_top),
+            (x_left, y_top),
+            (x_right, y_bottom),
+            (x_left, y_bottom),
+        ];
+        let crossed = |&(bx, by): &(i64, i64)| {
+            ink.iter()
+                .filter(|&&(x, y)| x >= bx && x < bx + box_w && y >= by && y < by + box_h)
+                .count()
+        };
+        let (bx, by) = corners
+            .iter()
+            .copied()
+            .min_by_key(crossed)
+            .unwrap_or(corners[0]);
         if !series.is_empty() {
-            let box_h = 14 * series.len() as u32 + 6;
-            img.fill_rect(x - 4, top + 6, (name_w + LEGEND_PAD) as u32, box_h, PAPER);
+            img.fill_rect(bx, by, box_w as u32, box_h as u32, PAPER);
         }
         for (i, s) in series.iter().enumerate() {
-            let y = top + 10 + 14 * i as i64;
+            let (x, y) = (bx + 4, by + 4 + 14 * i as i64);
             img.fill_rect(x, y + 3, 16, 3, s.color);
             draw_text(&mut img, x + 22, y, &s.name, 1, INK);
         }
@@ -123,14 +142,19 @@ impl Chart {
     }
 }
 
-/// A 2-pixel-wide line from `a` to `b` (pixels), clipped to the image.
-fn line(img: &mut Image, a: (f32, f32), b: (f32, f32), color: [u8; 3]) {
+/// A 2-pixel-wide line from `a` to `b` (pixels), clipped to the image; returns the pixels
+/// it was drawn through (one per step, before clipping).
+fn line(img: &mut Image, a: (f32, f32), b: (f32, f32), color: [u8; 3]) -> Vec<(i64, i64)> {
     let steps = ((b.0 - a.0).abs().max((b.1 - a.1).abs()).ceil() as usize).max(1);
-    for k in 0..=steps {
-        let t = k as f32 / steps as f32;
-        let (x, y) = (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
-        img.fill_rect(x.round() as i64, y.round() as i64, 2, 2, color);
-    }
+    (0..=steps)
+        .map(|k| {
+            let t = k as f32 / steps as f32;
+            let (x, y) = (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
+            let p = (x.round() as i64, y.round() as i64);
+            img.fill_rect(p.0, p.1, 2, 2, color);
+            p
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -154,11 +178,57 @@ mod tests {
             color: red,
             points: vec![(0.0, 0.0), (1.0, 1.0)],
         }]);
-        // Plot area: x 70..280, y 36..150. The line passes its centre, not its corners
-        // above the diagonal.
+        // Plot area: x 70..280, y 36..150. The line passes its centre, not the area above
+        // the diagonal (the legend's red swatch is in the top left corner).
         assert_eq!(img.pixel(175, 93), red);
-        assert_ne!(img.pixel(90, 50), red);
+        assert_ne!(img.pixel(150, 70), red);
         assert!(img.count_not(PAPER) > 500);
+    }
+
+    /// Regression: the legend sat in the top right corner whatever the curves did, and hid
+    /// the precision curves' top (they rise to the right). It goes where no curve runs.
+    #[test]
+    fn the_legend_keeps_off_the_curves() {
+        let chart = Chart {
+            title: "t".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            x_range: (0.0, 1.0),
+            y_range: (0.0, 1.0),
+            ticks: 4,
+            size: (400, 300),
+        };
+        let red = [255, 0, 0];
+        let curve = |points: Vec<(f32, f32)>| {
+            chart.draw(&[Series {
+                name: "a fairly long series name".into(),
+                color: red,
+                points,
+            }])
+        };
+        // Plot area: x 70..380, y 36..250. Red pixels covered by the paper box are lost.
+        let red_pixels = |img: &Image| {
+            (0..400)
+                .flat_map(|x| (0..300).map(move |y| (x, y)))
+                .filter(|&(x, y)| img.pixel(x, y) == red)
+                .count()
+        };
+        // A precision-like curve: up steeply, then on to 0.9 at the right edge, through the
+        // top right corner.
+        let rising = curve(vec![(0.0, 0.0), (0.3, 0.6), (1.0, 0.9)]);
+        // Along the bottom: the legend stays top right.
+        let flat = curve(vec![(0.0, 0.02), (1.0, 0.02)]);
+        for img in [&rising, &flat] {
+            assert!(red_pixels(img) > 2 * 300, "{}", red_pixels(img));
+        }
+        // The rising curve is drawn where the legend used to be (x 375: y 0.893, row 59),
+        // and the legend's text is in the top left instead.
+        assert_eq!(rising.pixel(375, 59), red, "curve under the legend");
+        let ink = |img: &Image, xs: std::ops::Range<u32>| {
+            (42..62).any(|y| xs.clone().any(|x| img.pixel(x, y) == INK))
+        };
+        assert!(ink(&rising, 72..200) && !ink(&rising, 330..380));
+        assert!(ink(&flat, 330..380) && !ink(&flat, 72..100));
     }
 
     /// Regression: names were drawn from a fixed 150 px before the right edge, so
