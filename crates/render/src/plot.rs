@@ -161,17 +161,22 @@ fn line(img: &mut Image, a: (f32, f32), b: (f32, f32), color: [u8; 3]) -> Vec<(i
 mod tests {
     use super::*;
 
-    #[test]
-    fn a_rising_line_is_drawn_from_lower_left_to_upper_right() {
-        let chart = Chart {
+    /// A chart of the unit square, `w` x `h` pixels.
+    fn unit_chart(w: u32, h: u32) -> Chart {
+        Chart {
             title: "t".into(),
             x_label: "x".into(),
             y_label: "y".into(),
             x_range: (0.0, 1.0),
             y_range: (0.0, 1.0),
             ticks: 4,
-            size: (300, 200),
-        };
+            size: (w, h),
+        }
+    }
+
+    #[test]
+    fn a_rising_line_is_drawn_from_lower_left_to_upper_right() {
+        let chart = unit_chart(300, 200);
         let red = [255, 0, 0];
         let img = chart.draw(&[Series {
             name: "s".into(),
@@ -189,15 +194,7 @@ mod tests {
     /// the precision curves' top (they rise to the right). It goes where no curve runs.
     #[test]
     fn the_legend_keeps_off_the_curves() {
-        let chart = Chart {
-            title: "t".into(),
-            x_label: "x".into(),
-            y_label: "y".into(),
-            x_range: (0.0, 1.0),
-            y_range: (0.0, 1.0),
-            ticks: 4,
-            size: (400, 300),
-        };
+        let chart = unit_chart(400, 300);
         let red = [255, 0, 0];
         let curve = |points: Vec<(f32, f32)>| {
             chart.draw(&[Series {
@@ -235,15 +232,7 @@ mod tests {
     /// "tshirt GarNet-global" ran off the plot.
     #[test]
     fn a_long_legend_name_stays_inside_the_plot() {
-        let chart = Chart {
-            title: "t".into(),
-            x_label: "x".into(),
-            y_label: "y".into(),
-            x_range: (0.0, 1.0),
-            y_range: (0.0, 1.0),
-            ticks: 4,
-            size: (400, 200),
-        };
+        let chart = unit_chart(400, 200);
         let name = "sweater GarNet-global and more";
         let img = chart.draw(&[Series {
             name: name.into(),
