@@ -33,26 +33,26 @@ pub struct SavedDrape<'a> {
 }
 
 /// Writes one model's evaluated drapes into its own folder.
-pub struct DrapeSaver {
+pub struct DrapeSaver<'a> {
     dir: PathBuf,
-    garment_faces: Vec<[u32; 3]>,
-    body_faces: Vec<[u32; 3]>,
+    garment_faces: &'a [[u32; 3]],
+    body_faces: &'a [[u32; 3]],
     rows: Vec<String>,
 }
 
-impl DrapeSaver {
+impl<'a> DrapeSaver<'a> {
     /// Creates the folder `dir` for one model; `garment_faces` are its template's triangles,
     /// `body_faces` the dataset body's.
     pub fn new(
         dir: &Path,
-        garment_faces: &[[u32; 3]],
-        body_faces: &[[u32; 3]],
+        garment_faces: &'a [[u32; 3]],
+        body_faces: &'a [[u32; 3]],
     ) -> anyhow::Result<Self> {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         Ok(DrapeSaver {
             dir: dir.to_path_buf(),
-            garment_faces: garment_faces.to_vec(),
-            body_faces: body_faces.to_vec(),
+            garment_faces,
+            body_faces,
             rows: Vec::new(),
         })
     }
@@ -60,14 +60,14 @@ impl DrapeSaver {
     /// Writes the four meshes of `drape` and remembers its row of `samples.csv`.
     pub fn save(&mut self, drape: &SavedDrape) -> anyhow::Result<()> {
         let meshes = [
-            ("net", drape.net, &self.garment_faces),
-            ("sim", drape.sim, &self.garment_faces),
-            ("dqs", drape.dqs, &self.garment_faces),
-            ("body", drape.body, &self.body_faces),
+            ("net", drape.net, self.garment_faces),
+            ("sim", drape.sim, self.garment_faces),
+            ("dqs", drape.dqs, self.garment_faces),
+            ("body", drape.body, self.body_faces),
         ];
         for (what, vertices, faces) in meshes {
             let path = self.dir.join(format!("{:06}-{what}.ply", drape.index));
-            let mesh = TriMesh::new(vertices.to_vec(), faces.clone());
+            let mesh = TriMesh::new(vertices.to_vec(), faces.to_vec());
             geom::io::write_mesh(&path, &mesh)
                 .with_context(|| format!("writing {}", path.display()))?;
         }
