@@ -45,6 +45,11 @@ pub enum BenchCmd {
         /// Where the networks run.
         #[arg(long, value_enum, default_value_t = DeviceArg::Cpu)]
         device: DeviceArg,
+        /// Time networks of these widths and inputs (a JSON file of `GarNetConfig` fields
+        /// over the defaults, as `garnet train --config`) instead of the defaults; the
+        /// same-drape rows then compare GarNet-Local of this file with the paper's.
+        #[arg(long, value_name = "FILE")]
+        config: Option<std::path::PathBuf>,
     },
 }
 
@@ -58,7 +63,15 @@ pub fn run(cmd: &BenchCmd) -> anyhow::Result<()> {
             simulator,
             edge,
             device,
-        } => crate::bench_model::bench_model(*runs, sizes, *simulator, *edge, *device),
+            config,
+        } => crate::bench_model::bench_model(
+            *runs,
+            sizes,
+            *simulator,
+            *edge,
+            *device,
+            config.as_deref(),
+        ),
     }
 }
 

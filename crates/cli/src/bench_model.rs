@@ -11,6 +11,8 @@ use model::{Draper, GarNetConfig, ModelSetup, Variant};
 use crate::bench_cmd::TshirtCase;
 use crate::drape_cmd::{beside_push_out_collider, push_out_gap, PUSH_OUT_WITHIN};
 use crate::model_device::DeviceArg;
+use crate::train_cmd::network_config;
+use std::path::Path;
 
 /// Body vertices the networks see (the body model's mesh).
 const BODY_VERTICES: usize = 13380;
@@ -18,14 +20,17 @@ const BODY_VERTICES: usize = 13380;
 /// Runs the benchmark and prints a Markdown table; the reference is the DQS warp of a T-shirt
 /// with `edge` metres; with `simulator`, also the GarNet-Local and simulator times of the same
 /// drape of that T-shirt. The networks run on `device` (the DQS warp and the simulator always
-/// on the CPU).
+/// on the CPU) with the widths and inputs of the `config` file (`garnet train --config`), or
+/// the defaults.
 pub fn bench_model(
     runs: usize,
     sizes: &[usize],
     simulator: bool,
     edge: f32,
     device: DeviceArg,
+    config: Option<&Path>,
 ) -> anyhow::Result<()> {
+    let networks = BenchNetworks { file: config };
     let backend = device.backend_name();
     let device = device.device()?;
     let body_model = BodyModel::load()?;
@@ -43,9 +48,22 @@ pub fn bench_model(
         "| DQS warp (reference) | | {} | | {warp_ms:.2} | | 1 |",
         reference.template.mesh.vertices.len()
     );
+    if let Some(path) = config {
+        println!(
+            "networks of {}; the synthetic rows without body contact (their ellipsoid body \
+             has no faces), the same-drape rows with every input of the file",
+            path.display()
+        );
+    }
     for &n in sizes {
         for variant in Variant::ALL {
-            let b = bench_forward(&GarNetConfig::new(variant), n, BODY_VERTICES, runs, &device)?;
+            let b = bench_forward(
+                &networks.synthetic(variant)?,
+                n,
+                BODY_VERTICES,
+                runs,
+                &device,
+            )?;
             let t = &b.drape;
             println!(
                 "| drape (forward, batch 1) | {} | {} | {} | {:.1} ({:.1}..{:.1}) | {:.1} | {:.0} |",
@@ -61,12 +79,12 @@ pub fn bench_model(
         }
     }
     if simulator {
-        same_drape(&reference, runs, &device)?;
+        same_drape(&reference, runs, &device, &networks)?;
     }
     for &n in sizes {
         for variant in Variant::ALL {
             let b = bench_train_step(
-                &GarNetConfig::new(variant),
+                &networks.synthetic(variant)?,
                 n,
                 BODY_VERTICES,
                 1,
@@ -89,22 +107,55 @@ pub fn bench_model(
     Ok(())
 }
 
-/// GarNet-Local (default widths; the time does not depend on the trained values) and the
-/// simulator on the same drape: the benchmark's T-shirt on its posed body. Prints a row
-/// each and their ratio.
-fn same_drape(case: &TshirtCase, runs: usize, device: &Device) -> anyhow::Result<()> {
+/// The networks a run of the benchmark times: the defaults, or a `--config` file's.
+struct BenchNetworks<'a> {
+    file: Option<&'a Path>,
+}
+
+impl BenchNetworks<'_> {
+    /// `variant` with the file's widths and inputs, or the defaults.
+    fn config(&self, variant: Variant) -> anyhow::Result<GarNetConfig> {
+        match self.file {
+            Some(path) => network_config(path, variant),
+            None => Ok(GarNetConfig::new(variant)),
+        }
+    }
+
+    /// [`BenchNetworks::config`] for the synthetic ellipsoid body, which has no faces for the
+    /// body-contact features.
+    fn synthetic(&self, variant: Variant) -> anyhow::Result<GarNetConfig> {
+        Ok(self.config(variant)?.with_body_contact(false))
+    }
+
+    /// The GarNet-Local networks of the same-drape rows: the paper's, then the file's (the
+    /// defaults with our body-contact features when no file is given).
+    fn same_drape(&self) -> anyhow::Result<[GarNetConfig; 2]> {
+        let paper = GarNetConfig::new(Variant::Local);
+        let ours = match self.file {
+            Some(_) => self.config(Variant::Local)?,
+            None => GarNetConfig::new(Variant::Local).with_body_contact(true),
+        };
+        Ok([paper, ours])
+    }
+}
+
+/// GarNet-Local (the time does not depend on the trained values) and the simulator on the
+/// same drape: the benchmark's T-shirt on its posed body. Prints a row each and their ratio.
+fn same_drape(
+    case: &TshirtCase,
+    runs: usize,
+    device: &Device,
+    networks: &BenchNetworks,
+) -> anyhow::Result<()> {
     let sim = case.simulate()?;
     let body = &sim.body.vertices;
     let warped = garment::warp::warp(&case.template, &case.target, &sim.pose, Skinning::Dqs)?;
     let n = case.template.mesh.vertices.len();
     let sim_ms = sim.stats.wall_time_s * 1e3;
     let warp_ms = case.warp.as_secs_f64() * 1e3;
-    // The paper's GarNet-Local, then with our body-contact features (their nearest-vertex
-    // search and body normals run per drape).
-    for config in [
-        GarNetConfig::new(Variant::Local),
-        GarNetConfig::new(Variant::Local).with_body_contact(true),
-    ] {
+    // The paper's GarNet-Local, then ours (the body-contact features' nearest-vertex search
+    // and body normals run per drape).
+    for config in networks.same_drape()? {
         let setup = ModelSetup::new(config, case.template.mesh.clone(), body)?
             .with_body_faces(sim.body.faces.clone())?;
         let name = setup.config.method_name();

@@ -194,7 +194,7 @@ impl<'a> GarmentSplit<'a> {
 
 /// Reads a `--config` file: a JSON object of [`GarNetConfig`] fields over the defaults of
 /// `variant`, whose variant it takes.
-fn network_config(path: &Path, variant: Variant) -> anyhow::Result<GarNetConfig> {
+pub fn network_config(path: &Path, variant: Variant) -> anyhow::Result<GarNetConfig> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("reading the network config {}", path.display()))?;
     let mut fields: serde_json::Map<String, serde_json::Value> = serde_json::from_str(&text)

@@ -604,6 +604,64 @@ fn bench_model_reports_every_variant_against_the_dqs_warp() {
     assert!(out.contains("faster than the simulator"), "{out}");
 }
 
+/// `--config` times networks of a file's widths and inputs: the same-drape rows compare
+/// the paper's GarNet-Local with the file's (here deeper, with the body-contact and
+/// template-vertex inputs), and the parameter counts are the file's.
+#[test]
+fn bench_model_times_the_networks_of_a_config_file() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("net.json");
+    std::fs::write(
+        &file,
+        r#"{"convs_per_block": 2, "body_contact": true, "rest_input": true}"#,
+    )
+    .unwrap();
+    let args = |config: &Path| {
+        owned(&[
+            "bench",
+            "model",
+            "--runs",
+            "1",
+            "--sizes",
+            "300",
+            "--edge",
+            "0.05",
+            "--simulator",
+            "--config",
+            s(config),
+        ])
+    };
+    let out = ok(&as_str(&args(&file)));
+    assert!(out.contains("net.json"), "{out}");
+    for name in ["GarNet-local", "GarNet-local +contact +rest"] {
+        assert!(
+            out.contains(&format!("same drape: {name} with the push-out")),
+            "{out}"
+        );
+    }
+    // Twice the mesh convolutions: more parameters than the defaults in the Local and
+    // Global rows; Naive has none, and gains only the template vertices' 3 inputs to its
+    // first 64-wide layer (the synthetic rows leave the body contact out).
+    let params = |out: &str, variant: &str| -> usize {
+        let row = out
+            .lines()
+            .find(|l| l.starts_with("| drape (forward") && l.contains(variant))
+            .unwrap_or_else(|| panic!("no {variant} drape row:\n{out}"));
+        row.split('|').nth(4).unwrap().trim().parse().unwrap()
+    };
+    let defaults = ok(&["bench", "model", "--runs", "1", "--sizes", "300"]);
+    assert!(params(&out, "| local |") > params(&defaults, "| local |"));
+    assert!(params(&out, "| global |") > params(&defaults, "| global |"));
+    assert_eq!(params(&out, "| naive |"), params(&defaults, "| naive |") + 3 * 64);
+    let bad = tmp.path().join("bad.json");
+    std::fs::write(&bad, r#"{"conv_widht": 64}"#).unwrap();
+    let err = fails(&as_str(&args(&bad)));
+    assert!(
+        err.contains("bad.json") && err.contains("conv_widht"),
+        "{err}"
+    );
+}
+
 /// A GPU backend this build lacks is refused before any work, naming the cargo feature.
 #[test]
 fn bench_model_on_a_backend_not_built_in_says_how_to_build_it() {
