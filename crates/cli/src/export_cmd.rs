@@ -41,8 +41,10 @@ pub struct ExportArgs {
     /// Model file to write (`.garnet`); the card goes beside it with the extension `.md`.
     #[arg(long, value_name = "FILE.garnet")]
     pub out: PathBuf,
-    /// The drapes the model was trained on (`garnet train`'s filter): the card counts them
-    /// and adds the metrics on the test drapes that pass it.
+    /// A filter of drapes (`garnet train`'s flags): the card counts the training drapes that
+    /// pass it and adds the metrics on the test drapes that pass it. What the model trained
+    /// on each epoch comes from its run's `metrics.csv` beside `--model` where there is one,
+    /// else the card takes it to be these drapes.
     #[command(flatten)]
     pub drapes: DrapeFilterArgs,
 }
@@ -148,8 +150,15 @@ fn model_card(
     let size_mb = std::fs::metadata(path)?.len() as f64 / 1e6;
     let mut train_indices = train.select(Some("train"), Some(&eval.garment))?;
     let train_all = train_indices.len();
-    let trained_on = match filtered {
-        Some((f, _)) => {
+    // What the run trained on, from its log where there is one: a model fine-tuned from
+    // another on other drapes has its own count per epoch, whatever the export's filter.
+    let metrics_csv = source
+        .parent()
+        .map(|d| d.join(model::trainer::METRICS_LOG))
+        .and_then(|m| std::fs::read_to_string(m).ok());
+    let samples_history = metrics_csv.as_deref().and_then(training_samples_history);
+    let trained_on = match (filtered, samples_history) {
+        (Some((f, _)), None) => {
             train.retain_drapes(&mut train_indices, f);
             format!(
                 "{} training samples of this garment, trained on the {} of them that are {}",
@@ -158,7 +167,21 @@ fn model_card(
                 f.describe()
             )
         }
-        None => format!("{train_all} training samples of this garment"),
+        (Some((f, _)), Some(h)) => {
+            train.retain_drapes(&mut train_indices, f);
+            format!(
+                "{} training samples of this garment, {} of them {}; samples trained on per \
+                 epoch (from the run's metrics.csv): {h}",
+                train_all,
+                train_indices.len(),
+                f.describe()
+            )
+        }
+        (None, Some(h)) => format!(
+            "{train_all} training samples of this garment; samples trained on per epoch (from \
+             the run's metrics.csv): {h}"
+        ),
+        (None, None) => format!("{train_all} training samples of this garment"),
     };
     let [net, dqs] = eval.summary();
     let (net_ms, sim_s) = eval.times();
@@ -214,11 +237,9 @@ fn model_card(
         } else {
             ""
         },
-        history = source
-            .parent()
-            .map(|d| d.join(model::trainer::METRICS_LOG))
-            .and_then(|m| std::fs::read_to_string(m).ok())
-            .and_then(|csv| learning_rate_history(&csv))
+        history = metrics_csv
+            .as_deref()
+            .and_then(learning_rate_history)
             .map_or(String::new(), |h| format!(
                 "- learning rate by epoch (from the run's metrics.csv): {h}\n"
             )),
@@ -299,11 +320,7 @@ fn learning_rate_history(csv: &str) -> Option<String> {
     let text: Vec<String> = segments
         .iter()
         .map(|&(a, b, l0, l1)| {
-            let span = if a == b {
-                format!("epoch {a}")
-            } else {
-                format!("epochs {a}-{b}")
-            };
+            let span = epoch_span(a, b);
             if l0 == l1 {
                 format!("{l0:.1e} ({span})")
             } else {
@@ -319,9 +336,44 @@ fn learning_rate_history(csv: &str) -> Option<String> {
     })
 }
 
+/// The training samples per epoch of a training log (`metrics.csv` text) as runs of epochs
+/// with the same count: `1229 (epochs 1-30), 1500 (epochs 31-45)`; `None` for a log without
+/// rows.
+fn training_samples_history(csv: &str) -> Option<String> {
+    // (first epoch, last epoch, samples)
+    let mut runs: Vec<(usize, usize, u64)> = Vec::new();
+    for line in csv.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let (Some(epoch), Some(n)) = (
+            f.first().and_then(|e| e.parse().ok()),
+            f.get(4).and_then(|n| n.parse().ok()),
+        ) else {
+            continue;
+        };
+        match runs.last_mut() {
+            Some(r) if r.2 == n => r.1 = epoch,
+            _ => runs.push((epoch, epoch, n)),
+        }
+    }
+    let text: Vec<String> = runs
+        .iter()
+        .map(|&(a, b, n)| format!("{n} ({})", epoch_span(a, b)))
+        .collect();
+    (!text.is_empty()).then(|| text.join(", "))
+}
+
+/// `epoch A` or `epochs A-B`.
+fn epoch_span(first: usize, last: usize) -> String {
+    if first == last {
+        format!("epoch {first}")
+    } else {
+        format!("epochs {first}-{last}")
+    }
+}
+
 #[cfg(test)]
 mod tests {
-    use super::learning_rate_history;
+    use super::{learning_rate_history, training_samples_history};
 
     #[test]
     fn learning_rates_fold_into_constant_and_falling_segments() {
@@ -343,5 +395,29 @@ mod tests {
              best checkpoint from epoch 6"
         );
         assert_eq!(learning_rate_history(header), None);
+    }
+
+    /// A run fine-tuned on every drape after epochs on the clean ones shows both counts.
+    #[test]
+    fn training_samples_fold_into_runs_of_equal_counts() {
+        let header = model::metrics_log::HEADER;
+        let row =
+            |e: usize, n: u64| format!("{e},0,1e-4,1.0,{n},1,1,0,0,0,2,1,1,0,0,0,3.5,20,0,100");
+        let mut csv = format!("{header}\n");
+        for (e, n) in [
+            (1, 1229),
+            (2, 1229),
+            (3, 1229),
+            (4, 1500),
+            (5, 1500),
+            (6, 7),
+        ] {
+            csv += &(row(e, n) + "\n");
+        }
+        assert_eq!(
+            training_samples_history(&csv).unwrap(),
+            "1229 (epochs 1-3), 1500 (epochs 4-5), 7 (epoch 6)"
+        );
+        assert_eq!(training_samples_history(header), None);
     }
 }

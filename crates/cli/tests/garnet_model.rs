@@ -190,8 +190,10 @@ fn train_resume_eval_and_drape() {
         "best validation E_dist",
         "every other training sample mirrored left-right",
         "learning rate by epoch (from the run's metrics.csv): 1.0e-3 (epochs 1-3)",
-        // The drapes it was trained on (the filter given to export), and its metrics on them.
-        "trained on the 2 of them that are drapes with strain p99 at most 1000%",
+        // The drapes it was trained on (from the run's log), those the export's filter
+        // passes, and its metrics on the test drapes that pass it.
+        "2 training samples of this garment, 2 of them drapes with strain p99 at most 1000%",
+        "samples trained on per epoch (from the run's metrics.csv): 2 (epochs 1-3)",
         "| GarNet-local, drapes with strain p99 at most 1000% |",
         "| DQS warp, drapes with strain p99 at most 1000% |",
         "--max-strain 1000`.",
@@ -573,19 +575,18 @@ fn as_str(v: &[String]) -> Vec<&str> {
     v.iter().map(String::as_str).collect()
 }
 
+/// `garnet bench model` on a 300-vertex synthetic garment and the 5 cm T-shirt's drape, one
+/// run each, then `extra`.
+fn small_bench_model(extra: &[&str]) -> Vec<String> {
+    let mut a = owned(&["bench", "model", "--runs", "1", "--sizes", "300"]);
+    a.extend(owned(&["--edge", "0.05", "--simulator"]));
+    a.extend(owned(extra));
+    a
+}
+
 #[test]
 fn bench_model_reports_every_variant_against_the_dqs_warp() {
-    let out = ok(&[
-        "bench",
-        "model",
-        "--runs",
-        "1",
-        "--sizes",
-        "300",
-        "--edge",
-        "0.05",
-        "--simulator",
-    ]);
+    let out = ok(&as_str(&small_bench_model(&[])));
     assert!(out.contains("DQS warp (reference)"), "{out}");
     // A drape row and a training-step row each; GarNet-Local, with and without the
     // body-contact features, also on the simulator's drape, alone and with the push-out.
@@ -616,21 +617,7 @@ fn bench_model_times_the_networks_of_a_config_file() {
         r#"{"convs_per_block": 2, "body_contact": true, "rest_input": true}"#,
     )
     .unwrap();
-    let args = |config: &Path| {
-        owned(&[
-            "bench",
-            "model",
-            "--runs",
-            "1",
-            "--sizes",
-            "300",
-            "--edge",
-            "0.05",
-            "--simulator",
-            "--config",
-            s(config),
-        ])
-    };
+    let args = |config: &Path| small_bench_model(&["--config", s(config)]);
     let out = ok(&as_str(&args(&file)));
     assert!(out.contains("net.json"), "{out}");
     for name in ["GarNet-local", "GarNet-local +contact +rest"] {
@@ -652,7 +639,10 @@ fn bench_model_times_the_networks_of_a_config_file() {
     let defaults = ok(&["bench", "model", "--runs", "1", "--sizes", "300"]);
     assert!(params(&out, "| local |") > params(&defaults, "| local |"));
     assert!(params(&out, "| global |") > params(&defaults, "| global |"));
-    assert_eq!(params(&out, "| naive |"), params(&defaults, "| naive |") + 3 * 64);
+    assert_eq!(
+        params(&out, "| naive |"),
+        params(&defaults, "| naive |") + 3 * 64
+    );
     let bad = tmp.path().join("bad.json");
     std::fs::write(&bad, r#"{"conv_widht": 64}"#).unwrap();
     let err = fails(&as_str(&args(&bad)));
