@@ -30,7 +30,7 @@ pub fn bench_model(
     device: DeviceArg,
     config: Option<&Path>,
 ) -> anyhow::Result<()> {
-    let networks = BenchNetworks { file: config };
+    let networks = BenchNetworks::new(config)?;
     let backend = device.backend_name();
     let device = device.device()?;
     let body_model = BodyModel::load()?;
@@ -58,7 +58,7 @@ pub fn bench_model(
     for &n in sizes {
         for variant in Variant::ALL {
             let b = bench_forward(
-                &networks.synthetic(variant)?,
+                &networks.synthetic(variant),
                 n,
                 BODY_VERTICES,
                 runs,
@@ -84,7 +84,7 @@ pub fn bench_model(
     for &n in sizes {
         for variant in Variant::ALL {
             let b = bench_train_step(
-                &networks.synthetic(variant)?,
+                &networks.synthetic(variant),
                 n,
                 BODY_VERTICES,
                 1,
@@ -107,35 +107,52 @@ pub fn bench_model(
     Ok(())
 }
 
-/// The networks a run of the benchmark times: the defaults, or a `--config` file's.
-struct BenchNetworks<'a> {
-    file: Option<&'a Path>,
+/// The networks a run of the benchmark times: the defaults, or a `--config` file's (read
+/// once).
+struct BenchNetworks {
+    /// Each variant's config, in the order of [`Variant::ALL`].
+    configs: Vec<GarNetConfig>,
+    from_file: bool,
 }
 
-impl BenchNetworks<'_> {
+impl BenchNetworks {
+    /// The networks of the `file`'s widths and inputs, or the defaults.
+    fn new(file: Option<&Path>) -> anyhow::Result<Self> {
+        let configs = Variant::ALL
+            .iter()
+            .map(|&v| match file {
+                Some(path) => network_config(path, v),
+                None => Ok(GarNetConfig::new(v)),
+            })
+            .collect::<anyhow::Result<_>>()?;
+        Ok(Self {
+            configs,
+            from_file: file.is_some(),
+        })
+    }
+
     /// `variant` with the file's widths and inputs, or the defaults.
-    fn config(&self, variant: Variant) -> anyhow::Result<GarNetConfig> {
-        match self.file {
-            Some(path) => network_config(path, variant),
-            None => Ok(GarNetConfig::new(variant)),
-        }
+    fn config(&self, variant: Variant) -> &GarNetConfig {
+        let i = Variant::ALL.iter().position(|&v| v == variant);
+        &self.configs[i.expect("Variant::ALL holds every variant")]
     }
 
     /// [`BenchNetworks::config`] for the synthetic ellipsoid body, which has no faces for the
     /// body-contact features.
-    fn synthetic(&self, variant: Variant) -> anyhow::Result<GarNetConfig> {
-        Ok(self.config(variant)?.with_body_contact(false))
+    fn synthetic(&self, variant: Variant) -> GarNetConfig {
+        self.config(variant).clone().with_body_contact(false)
     }
 
     /// The GarNet-Local networks of the same-drape rows: the paper's, then the file's (the
     /// defaults with our body-contact features when no file is given).
-    fn same_drape(&self) -> anyhow::Result<[GarNetConfig; 2]> {
+    fn same_drape(&self) -> [GarNetConfig; 2] {
         let paper = GarNetConfig::new(Variant::Local);
-        let ours = match self.file {
-            Some(_) => self.config(Variant::Local)?,
-            None => GarNetConfig::new(Variant::Local).with_body_contact(true),
+        let ours = if self.from_file {
+            self.config(Variant::Local).clone()
+        } else {
+            paper.clone().with_body_contact(true)
         };
-        Ok([paper, ours])
+        [paper, ours]
     }
 }
 
@@ -155,7 +172,7 @@ fn same_drape(
     let warp_ms = case.warp.as_secs_f64() * 1e3;
     // The paper's GarNet-Local, then ours (the body-contact features' nearest-vertex search
     // and body normals run per drape).
-    for config in networks.same_drape()? {
+    for config in networks.same_drape() {
         let setup = ModelSetup::new(config, case.template.mesh.clone(), body)?
             .with_body_faces(sim.body.faces.clone())?;
         let name = setup.config.method_name();

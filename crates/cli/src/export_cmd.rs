@@ -157,32 +157,18 @@ fn model_card(
         .map(|d| d.join(model::trainer::METRICS_LOG))
         .and_then(|m| std::fs::read_to_string(m).ok());
     let samples_history = metrics_csv.as_deref().and_then(training_samples_history);
-    let trained_on = match (filtered, samples_history) {
-        (Some((f, _)), None) => {
-            train.retain_drapes(&mut train_indices, f);
-            format!(
-                "{} training samples of this garment, trained on the {} of them that are {}",
-                train_all,
-                train_indices.len(),
-                f.describe()
-            )
-        }
-        (Some((f, _)), Some(h)) => {
-            train.retain_drapes(&mut train_indices, f);
-            format!(
-                "{} training samples of this garment, {} of them {}; samples trained on per \
-                 epoch (from the run's metrics.csv): {h}",
-                train_all,
-                train_indices.len(),
-                f.describe()
-            )
-        }
-        (None, Some(h)) => format!(
-            "{train_all} training samples of this garment; samples trained on per epoch (from \
-             the run's metrics.csv): {h}"
-        ),
-        (None, None) => format!("{train_all} training samples of this garment"),
-    };
+    let mut trained_on = format!("{train_all} training samples of this garment");
+    if let Some((f, _)) = filtered {
+        train.retain_drapes(&mut train_indices, f);
+        let (n, drapes) = (train_indices.len(), f.describe());
+        trained_on += &match samples_history {
+            None => format!(", trained on the {n} of them that are {drapes}"),
+            Some(_) => format!(", {n} of them {drapes}"),
+        };
+    }
+    if let Some(h) = &samples_history {
+        trained_on += &format!("; samples trained on per epoch (from the run's metrics.csv): {h}");
+    }
     let [net, dqs] = eval.summary();
     let (net_ms, sim_s) = eval.times();
     let mut md = format!(
