@@ -225,10 +225,18 @@ fn model_card(
         },
         history = metrics_csv
             .as_deref()
-            .and_then(learning_rate_history)
+            .and_then(|csv| learning_rate_history(csv, !state.averaged_epochs.is_empty()))
             .map_or(String::new(), |h| format!(
                 "- learning rate by epoch (from the run's metrics.csv): {h}\n"
-            )),
+            ))
+            + &if state.averaged_epochs.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    "- weights: the mean of the networks of {} (`garnet average`)\n",
+                    epoch_list(&state.averaged_epochs)
+                )
+            },
     );
     md += &format!(
         "## Test metrics ('{split}' split of '{name}', `{dir}`: bodies never seen in \
@@ -277,8 +285,9 @@ fn model_card(
 
 /// The learning rates of a training log (`metrics.csv` text) as segments of epochs: a
 /// constant rate as `3e-4 (epochs 1-22)`, a falling one as `1e-3 to 1e-5 (epochs 23-50)`,
-/// with the epoch that wrote the best checkpoint; `None` for a log without rows.
-fn learning_rate_history(csv: &str) -> Option<String> {
+/// with the epoch that wrote the best checkpoint (left out for a model averaged by `garnet
+/// average`: `averaged`); `None` for a log without rows.
+fn learning_rate_history(csv: &str, averaged: bool) -> Option<String> {
     let rows: Vec<(usize, f64, bool)> = csv
         .lines()
         .skip(1)
@@ -314,12 +323,11 @@ fn learning_rate_history(csv: &str) -> Option<String> {
             }
         })
         .collect();
-    (!text.is_empty()).then(|| {
-        text.join(", ")
-            + &best.map_or(String::new(), |b| {
-                format!("; best checkpoint from epoch {b}")
-            })
-    })
+    let source = match best {
+        Some(b) if !averaged => format!("; best checkpoint from epoch {b}"),
+        _ => String::new(),
+    };
+    (!text.is_empty()).then(|| text.join(", ") + &source)
 }
 
 /// The training samples per epoch of a training log (`metrics.csv` text) as runs of epochs
@@ -357,9 +365,21 @@ fn epoch_span(first: usize, last: usize) -> String {
     }
 }
 
+/// Epochs as `epochs 70-76` when they follow one another, else `epochs 70, 72, 74`.
+fn epoch_list(epochs: &[usize]) -> String {
+    let consecutive = epochs.windows(2).all(|w| w[1] == w[0] + 1);
+    match (epochs.first(), epochs.last()) {
+        (Some(&a), Some(&b)) if consecutive => epoch_span(a, b),
+        _ => {
+            let list: Vec<String> = epochs.iter().map(usize::to_string).collect();
+            format!("epochs {}", list.join(", "))
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
-    use super::{learning_rate_history, training_samples_history};
+    use super::{epoch_list, learning_rate_history, training_samples_history};
 
     #[test]
     fn learning_rates_fold_into_constant_and_falling_segments() {
@@ -376,11 +396,17 @@ mod tests {
         }
         csv += &(row(8, 1e-5, 0) + "\n");
         assert_eq!(
-            learning_rate_history(&csv).unwrap(),
+            learning_rate_history(&csv, false).unwrap(),
             "3.0e-4 (epochs 1-3), 1.0e-3 to 1.0e-5 (epochs 4-7), 1.0e-5 (epoch 8); \
              best checkpoint from epoch 6"
         );
-        assert_eq!(learning_rate_history(header), None);
+        assert_eq!(
+            learning_rate_history(&csv, true).unwrap(),
+            "3.0e-4 (epochs 1-3), 1.0e-3 to 1.0e-5 (epochs 4-7), 1.0e-5 (epoch 8)"
+        );
+        assert_eq!(learning_rate_history(header, false), None);
+        assert_eq!(epoch_list(&[3, 5, 8]), "epochs 3, 5, 8");
+        assert_eq!(epoch_list(&[4]), "epoch 4");
     }
 
     /// A run fine-tuned on every drape after epochs on the clean ones shows both counts.

@@ -1,6 +1,7 @@
 //! `garnet`: fast, accurate 3D cloth draping. Thin commands over the pipeline crates.
 
 mod assets_cmd;
+mod average_cmd;
 mod bench_cmd;
 mod bench_model;
 mod body_cmd;
@@ -64,6 +65,8 @@ enum Cmd {
     Train(train_cmd::TrainArgs),
     /// Export a training checkpoint as a model to ship, with its model card.
     Export(export_cmd::ExportArgs),
+    /// Average the networks of several checkpoints of one run into one (weight averaging).
+    Average(average_cmd::AverageArgs),
     /// The paper's errors (E_dist, E_norm) between two drapes of one garment mesh.
     Compare(compare_cmd::CompareArgs),
     /// Benchmarks measured in one run, reported with ratios to a reference.
@@ -84,6 +87,7 @@ fn main() {
         Some(Cmd::Drape(a)) => drape_cmd::run(a),
         Some(Cmd::Eval(a)) => eval_cmd::run(a),
         Some(Cmd::Export(a)) => export_cmd::run(a),
+        Some(Cmd::Average(a)) => average_cmd::run(a),
         Some(Cmd::Compare(a)) => compare_cmd::run(a),
         Some(Cmd::Train(a)) => train_cmd::run(a),
         Some(Cmd::Bench(c)) => bench_cmd::run(c),

@@ -272,6 +272,13 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
             .with_body_faces(train.topology.faces.clone())?;
         Trainer::new(setup, loss_config(args), args.lr, &device)?
     };
+    let validation_set = format!("{}:{}", data.manifest().spec.name, args.garment);
+    if let Some(old) = trainer.set_validation_set(&validation_set) {
+        eprintln!(
+            "the checkpoint's best validation E_dist ({old:.3} cm) was measured on another \
+             validation set; this run validates on '{validation_set}' and starts its best afresh"
+        );
+    }
     if args.grad_clip.is_some() {
         trainer.set_max_grad_norm(args.grad_clip)?;
     }

@@ -541,6 +541,65 @@ fn train_takes_the_network_widths_from_a_config_file() {
     );
 }
 
+/// `garnet average` of two epochs' checkpoints: a checkpoint that exports with a card naming
+/// the averaged epochs; checkpoints of another variant are refused.
+#[test]
+fn average_writes_a_checkpoint_that_exports() {
+    let data = dataset();
+    let tmp = tempfile::tempdir().unwrap();
+    let run = tmp.path().join("naive");
+    let mut snapshots = Vec::new();
+    for epochs in ["1", "2"] {
+        ok(&train_args(data, "naive", epochs, &run, &["--resume"]));
+        let snap = tmp.path().join(format!("epoch-{epochs}.garnet"));
+        std::fs::copy(run.join("last.garnet"), &snap).unwrap();
+        snapshots.push(snap);
+    }
+    let mean = tmp.path().join("mean.garnet");
+    let log = ok(&[
+        "average",
+        "--models",
+        s(&snapshots[0]),
+        s(&snapshots[1]),
+        "--out",
+        s(&mean),
+    ]);
+    assert!(log.contains("the mean of 2 networks"), "{log}");
+    let card_model = tmp.path().join("models").join("tshirt-naive.garnet");
+    ok(&[
+        "export",
+        "--model",
+        s(&mean),
+        "--data",
+        s(data),
+        "--out",
+        s(&card_model),
+    ]);
+    let card = std::fs::read_to_string(card_model.with_extension("md")).unwrap();
+    assert!(
+        card.contains("- weights: the mean of the networks of epochs 1-2 (`garnet average`)")
+            && card.contains("; then garnet average --models"),
+        "{card}"
+    );
+
+    let local = tmp.path().join("local");
+    ok(&train_args(data, "local", "1", &local, &[]));
+    let err = fails(&[
+        "average",
+        "--models",
+        s(&snapshots[0]),
+        s(&local.join("last.garnet")),
+        "--out",
+        s(&mean),
+    ]);
+    assert!(
+        err.contains("not averageable") && err.contains("last.garnet"),
+        "{err}"
+    );
+    let err = fails(&["average", "--models", s(&snapshots[0]), "--out", s(&mean)]);
+    assert!(err.contains("--models"), "{err}");
+}
+
 /// `v` as the `&str` arguments [`ok`] takes.
 /// `garnet train` on `data`'s T-shirts with `variant` for `epochs` into `out`, then `extra`.
 fn train_args<'a>(

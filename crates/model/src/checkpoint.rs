@@ -202,6 +202,14 @@ pub struct TrainState {
     pub lr: f64,
     /// Best validation E_dist so far, centimetres (`None` before the first validation).
     pub best_e_dist_cm: Option<f32>,
+    /// The validation set `best_e_dist_cm` was measured on (`dataset:garment`), when the
+    /// run named it (see [`crate::Trainer::set_validation_set`]).
+    #[serde(default)]
+    pub validation: Option<String>,
+    /// The epochs of the networks whose mean this network is (see [`crate::average`]);
+    /// empty for a network trained as it is (cleared by the next training epoch).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub averaged_epochs: Vec<usize>,
     /// The command line of the latest training run (for model cards), when it was given.
     #[serde(default)]
     pub command: Option<String>,

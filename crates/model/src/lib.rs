@@ -34,6 +34,7 @@
 #![warn(missing_docs)]
 
 pub mod alloc;
+pub mod average;
 pub mod batch;
 pub mod bench;
 pub mod body_stream;
@@ -63,6 +64,7 @@ pub mod train;
 pub mod trainer;
 
 pub use alloc::tune_allocator;
+pub use average::{average_checkpoints, average_networks, AverageReport};
 pub use batch::{Batch, BodyTopology, InputSpec, KnownBodies, NetInputs, Sample};
 pub use checkpoint::{load_checkpoint, save_checkpoint, Checkpoint, ModelSetup, TrainState};
 pub use config::{GarNetConfig, Variant};

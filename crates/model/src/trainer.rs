@@ -78,6 +78,8 @@ pub struct Trainer {
     state: TrainState,
     /// The template's mirror map, while training mirrors samples.
     mirror: Option<MirrorMap>,
+    /// The name of the validation set of this run (see [`Trainer::set_validation_set`]).
+    validation_set: Option<String>,
     device: Device,
 }
 
@@ -156,6 +158,7 @@ impl Trainer {
             lr,
             state,
             mirror: None,
+            validation_set: None,
             device,
         };
         trainer.set_mirror(trainer.state.mirror)?;
@@ -180,6 +183,22 @@ impl Trainer {
     /// Records the command line of this training run in the checkpoints it writes.
     pub fn set_command(&mut self, command: String) {
         self.state.command = Some(command);
+    }
+
+    /// Names this run's validation set (say `standard-x3-lbs:tshirt`). A best validation
+    /// E_dist that the checkpoint says was measured on another set does not compare with
+    /// this run's: it is cleared, so the next validated epoch writes `best.garnet`, and
+    /// returned. A best that a checkpoint carries without its set's name (written before
+    /// the name was stored) is kept. Every new best is stored with this name.
+    pub fn set_validation_set(&mut self, name: &str) -> Option<f32> {
+        self.validation_set = Some(name.to_string());
+        match &self.state.validation {
+            Some(old) if old != name => {
+                self.state.validation = None;
+                self.state.best_e_dist_cm.take()
+            }
+            _ => None,
+        }
     }
 
     /// The learning rate.
@@ -401,6 +420,7 @@ impl Trainer {
             self.lr = s.lr(self.state.epoch);
         }
         let (train_terms, train_samples, grad_norm) = self.train_epoch(train)?;
+        self.state.averaged_epochs.clear();
         let validation = match valid {
             Some(v) => Some(self.validate(v)?),
             None => None,
@@ -411,6 +431,7 @@ impl Trainer {
                 let better = self.state.best_e_dist_cm.is_none_or(|b| v.e_dist_cm < b);
                 if better {
                     self.state.best_e_dist_cm = Some(v.e_dist_cm);
+                    self.state.validation = self.validation_set.clone();
                 }
                 better
             }

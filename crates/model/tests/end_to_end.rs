@@ -695,3 +695,111 @@ fn bits_of(samples: &[Sample]) -> Vec<u32> {
         .collect();
     bits(&lists)
 }
+
+/// Regression (session 23): a run resumed on another dataset kept the best validation
+/// E_dist of the old one, so it never wrote `best.garnet`. A checkpoint now names the set
+/// its best was measured on, and a run validating on another set starts its best afresh.
+#[test]
+fn best_starts_afresh_on_another_validation_set() {
+    let device = Device::flex();
+    let dir = tempfile::tempdir().unwrap();
+    let s = setup(Variant::Naive, 40);
+    let data = samples(&s, 3);
+    let train = || vec![Ok::<_, String>(data[..2].to_vec())];
+    let valid = || vec![Ok::<_, String>(data[2..].to_vec())];
+    let mut trainer = Trainer::new(s, LossConfig::new(), 1e-3, &device).unwrap();
+    assert_eq!(trainer.set_validation_set("set-a:tube"), None);
+    trainer
+        .fit(1, |_| train(), Some(valid), dir.path(), |_| {})
+        .unwrap();
+    let (last, best, _) = Trainer::output_paths(dir.path());
+    let state = load_checkpoint(&best).unwrap().state;
+    assert_eq!(state.validation.as_deref(), Some("set-a:tube"));
+    let first_best = state.best_e_dist_cm.unwrap();
+
+    // The same set keeps the figure; another one clears it.
+    let mut same = Trainer::resume(&last, None, &device).unwrap();
+    assert_eq!(same.set_validation_set("set-a:tube"), None);
+    assert_eq!(same.state().best_e_dist_cm, Some(first_best));
+    let mut other = Trainer::resume(&last, None, &device).unwrap();
+    assert_eq!(other.set_validation_set("set-b:tube"), Some(first_best));
+    assert_eq!(other.state().best_e_dist_cm, None);
+
+    // A best far below anything reachable, carried in from the other set, would block
+    // every later best; cleared, the next epoch writes best.garnet.
+    let carried = load_checkpoint(&last).unwrap();
+    let mut state = carried.state.clone();
+    state.best_e_dist_cm = Some(1e-6);
+    let model = carried.model(&device).unwrap();
+    save_checkpoint(&last, &model, None, &carried.setup, &carried.loss, &state).unwrap();
+    std::fs::remove_file(&best).unwrap();
+    let mut resumed = Trainer::resume(&last, None, &device).unwrap();
+    assert_eq!(resumed.set_validation_set("set-b:tube"), Some(1e-6));
+    let reports = resumed
+        .fit(2, |_| train(), Some(valid), dir.path(), |_| {})
+        .unwrap();
+    assert!(reports[0].is_best && best.is_file());
+    let state = load_checkpoint(&best).unwrap().state;
+    assert_eq!(state.validation.as_deref(), Some("set-b:tube"));
+    assert_eq!(state.epoch, 2);
+}
+
+/// No validation data, for [`Trainer::fit`].
+const NO_VALIDATION: Option<fn() -> Vec<Result<Vec<Sample>, String>>> = None;
+
+/// `average_checkpoints` writes the mean network with the last input's progress, the
+/// averaged epochs and no best figure; checkpoints of other setups are refused.
+#[test]
+fn averaged_checkpoint_holds_the_mean_network() {
+    let device = Device::flex();
+    let dir = tempfile::tempdir().unwrap();
+    let s = setup(Variant::Global, 40);
+    let data = samples(&s, 2);
+    let train = || vec![Ok::<_, String>(data.clone())];
+    let mut trainer = Trainer::new(s.clone(), LossConfig::new(), 1e-3, &device).unwrap();
+    trainer.set_command("garnet train x".into());
+    let (last, _, _) = Trainer::output_paths(dir.path());
+    let mut snapshots = Vec::new();
+    for epoch in 1..=3 {
+        trainer
+            .fit(epoch, |_| train(), NO_VALIDATION, dir.path(), |_| {})
+            .unwrap();
+        let snap = dir.path().join(format!("epoch-{epoch}.garnet"));
+        std::fs::copy(&last, &snap).unwrap();
+        snapshots.push(snap);
+    }
+    let inputs: Vec<&std::path::Path> = snapshots.iter().map(|p| p.as_path()).collect();
+    let out = dir.path().join("mean.garnet");
+    let report = average_checkpoints(&inputs, &out, "garnet average").unwrap();
+    assert_eq!(report.epochs, vec![1, 2, 3]);
+    let mean = load_checkpoint(&out).unwrap();
+    assert!(!mean.has_optimizer());
+    assert_eq!(mean.state.epoch, 3);
+    assert_eq!(mean.state.averaged_epochs, vec![1, 2, 3]);
+    assert_eq!(mean.state.best_e_dist_cm, None);
+    assert!(mean
+        .state
+        .command
+        .as_deref()
+        .unwrap()
+        .ends_with("; then garnet average"));
+    let nets: Vec<GarNet> = inputs
+        .iter()
+        .map(|p| load_checkpoint(p).unwrap().model(&device).unwrap())
+        .collect();
+    let expected = model::average::parameter_values(&average_networks(&nets).unwrap()).unwrap();
+    let got = model::average::parameter_values(&mean.model(&device).unwrap()).unwrap();
+    assert_eq!(got, expected);
+    assert_ne!(got, model::average::parameter_values(&nets[2]).unwrap());
+
+    // One input, or inputs of another garment template, are refused.
+    assert!(average_checkpoints(&inputs[..1], &out, "x").is_err());
+    let other = dir.path().join("other.garnet");
+    let s2 = setup(Variant::Global, 90);
+    let t2 = Trainer::new(s2, LossConfig::new(), 1e-3, &device).unwrap();
+    t2.save(&other).unwrap();
+    let err = average_checkpoints(&[inputs[0], &other], &out, "x")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("not averageable"), "{err}");
+}

@@ -1,0 +1,42 @@
+//! `garnet average`: the element-wise mean of the networks of several checkpoints of one
+//! run (stochastic weight averaging), written as one checkpoint that drapes, evaluates,
+//! exports and resumes like any other.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{bail, Context};
+use clap::Args;
+
+/// Arguments of `garnet average`.
+#[derive(Args, Debug, Clone)]
+pub struct AverageArgs {
+    /// Checkpoints to average (two or more, of one architecture, garment and loss), say the
+    /// snapshots of a run's last epochs at a low constant learning rate.
+    #[arg(long, value_name = "CKPT", num_args = 2.., required = true)]
+    pub models: Vec<PathBuf>,
+    /// Checkpoint to write (`.garnet`), without optimiser state.
+    #[arg(long, value_name = "FILE.garnet")]
+    pub out: PathBuf,
+}
+
+/// Runs `garnet average`.
+pub fn run(args: &AverageArgs) -> anyhow::Result<()> {
+    if args.out.extension().and_then(|e| e.to_str()) != Some("garnet") {
+        bail!("{}: the checkpoint must end in .garnet", args.out.display());
+    }
+    let inputs: Vec<&Path> = args.models.iter().map(PathBuf::as_path).collect();
+    let command = std::iter::once("garnet".to_string())
+        .chain(std::env::args().skip(1))
+        .collect::<Vec<_>>()
+        .join(" ");
+    let report = model::average_checkpoints(&inputs, &args.out, &command)
+        .with_context(|| format!("averaging into {}", args.out.display()))?;
+    eprintln!(
+        "wrote {}: the mean of {} networks ({} parameters each) of epochs {:?}",
+        args.out.display(),
+        inputs.len(),
+        report.parameters,
+        report.epochs
+    );
+    Ok(())
+}
