@@ -25,10 +25,7 @@ pub fn run(args: &AverageArgs) -> anyhow::Result<()> {
         bail!("{}: the checkpoint must end in .garnet", args.out.display());
     }
     let inputs: Vec<&Path> = args.models.iter().map(PathBuf::as_path).collect();
-    let command = std::iter::once("garnet".to_string())
-        .chain(std::env::args().skip(1))
-        .collect::<Vec<_>>()
-        .join(" ");
+    let command = crate::output::command_line();
     let report = model::average_checkpoints(&inputs, &args.out, &command)
         .with_context(|| format!("averaging into {}", args.out.display()))?;
     eprintln!(

@@ -121,6 +121,13 @@ impl BenchNetworks {
         let configs = Variant::ALL
             .iter()
             .map(|&v| match file {
+                // Extra mesh-convolution blocks mean nothing to Naive: it is timed without.
+                Some(path) if v == Variant::Naive => {
+                    network_config(path, Variant::Global).map(|mut c| {
+                        c.variant = v;
+                        c.with_extra_blocks(0)
+                    })
+                }
                 Some(path) => network_config(path, v),
                 None => Ok(GarNetConfig::new(v)),
             })

@@ -16,6 +16,7 @@ mod eval_save;
 mod export_cmd;
 mod garment_cmd;
 mod garment_sheet;
+mod grow_cmd;
 mod model_device;
 mod output;
 mod pose_args;
@@ -67,6 +68,8 @@ enum Cmd {
     Export(export_cmd::ExportArgs),
     /// Average the networks of several checkpoints of one run into one (weight averaging).
     Average(average_cmd::AverageArgs),
+    /// Add residual blocks that start as the identity to a trained network (train it on after).
+    Grow(grow_cmd::GrowArgs),
     /// The paper's errors (E_dist, E_norm) between two drapes of one garment mesh.
     Compare(compare_cmd::CompareArgs),
     /// Benchmarks measured in one run, reported with ratios to a reference.
@@ -88,6 +91,7 @@ fn main() {
         Some(Cmd::Eval(a)) => eval_cmd::run(a),
         Some(Cmd::Export(a)) => export_cmd::run(a),
         Some(Cmd::Average(a)) => average_cmd::run(a),
+        Some(Cmd::Grow(a)) => grow_cmd::run(a),
         Some(Cmd::Compare(a)) => compare_cmd::run(a),
         Some(Cmd::Train(a)) => train_cmd::run(a),
         Some(Cmd::Bench(c)) => bench_cmd::run(c),

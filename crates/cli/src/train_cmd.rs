@@ -300,12 +300,7 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
         .map(|end| CosineSchedule::new(args.lr, end, trainer.state().epoch, args.epochs))
         .transpose()?;
     trainer.set_schedule(schedule);
-    trainer.set_command(
-        std::iter::once("garnet".to_string())
-            .chain(std::env::args().skip(1))
-            .collect::<Vec<_>>()
-            .join(" "),
-    );
+    trainer.set_command(crate::output::command_line());
     let params = trainer.model().num_params();
     eprintln!(
         "training {} ({params} parameters) on {} '{}' samples ({} validation), \

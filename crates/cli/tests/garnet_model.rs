@@ -600,6 +600,68 @@ fn average_writes_a_checkpoint_that_exports() {
     assert!(err.contains("--models"), "{err}");
 }
 
+/// `garnet grow`: the grown checkpoint evaluates as its parent, and `garnet train --resume`
+/// trains it on; Naive is refused.
+#[test]
+fn grow_keeps_the_drapes_and_trains_on() {
+    let data = dataset();
+    let tmp = tempfile::tempdir().unwrap();
+    let run = tmp.path().join("global");
+    ok(&train_args(data, "global", "1", &run, &[]));
+    let parent = tmp.path().join("parent.garnet");
+    std::fs::copy(run.join("last.garnet"), &parent).unwrap();
+    let grown = run.join("last.garnet");
+    let log = ok(&[
+        "grow",
+        "--model",
+        s(&parent),
+        "--extra-blocks",
+        "2",
+        "--out",
+        s(&grown),
+    ]);
+    assert!(log.contains("with 2 more blocks"), "{log}");
+    let e_dist = |model: &Path| {
+        let out = tmp.path().join("eval");
+        let report = ok(&[
+            "eval",
+            "--data",
+            s(data),
+            "--split",
+            "test",
+            "--model",
+            s(model),
+            "--out",
+            s(&out),
+        ]);
+        let row = report
+            .lines()
+            .find(|l| l.starts_with("| tshirt | GarNet-global"))
+            .unwrap_or_else(|| panic!("no GarNet row:\n{report}"))
+            .to_string();
+        row.split('|').nth(4).unwrap().trim().to_string()
+    };
+    assert_eq!(e_dist(&parent), e_dist(&grown));
+    let log = ok(&train_args(data, "global", "2", &run, &["--resume"]));
+    assert!(
+        log.contains("GarNet-global +2 blocks") && log.contains("epoch 2"),
+        "{log}"
+    );
+
+    let naive = tmp.path().join("naive");
+    ok(&train_args(data, "naive", "1", &naive, &[]));
+    let err = fails(&[
+        "grow",
+        "--model",
+        s(&naive.join("last.garnet")),
+        "--extra-blocks",
+        "1",
+        "--out",
+        s(&tmp.path().join("x.garnet")),
+    ]);
+    assert!(err.contains("Naive has no mesh convolutions"), "{err}");
+}
+
 /// `v` as the `&str` arguments [`ok`] takes.
 /// `garnet train` on `data`'s T-shirts with `variant` for `epochs` into `out`, then `extra`.
 fn train_args<'a>(

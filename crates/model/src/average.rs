@@ -181,10 +181,7 @@ pub fn average_checkpoints(inputs: &[&Path], out: &Path, command: &str) -> Resul
     state.best_e_dist_cm = None;
     state.validation = None;
     state.averaged_epochs = epochs.clone();
-    state.command = Some(match state.command.take() {
-        Some(c) => format!("{c}; then {command}"),
-        None => command.to_string(),
-    });
+    state.append_command(command);
     save_checkpoint(out, &mean, None, &setup, &loss, &state)?;
     Ok(AverageReport {
         epochs,

@@ -224,6 +224,17 @@ pub struct TrainState {
     pub mirror: bool,
 }
 
+impl TrainState {
+    /// Records `command` as made after the recorded command line (`"A; then B"`), for a
+    /// checkpoint written from another by `garnet average` or `garnet grow`.
+    pub fn append_command(&mut self, command: &str) {
+        self.command = Some(match self.command.take() {
+            Some(c) => format!("{c}; then {command}"),
+            None => command.to_string(),
+        });
+    }
+}
+
 /// A checkpoint read from disk; [`Checkpoint::model`] and [`Checkpoint::optimizer`] rebuild
 /// the network and the optimiser.
 pub struct Checkpoint {
@@ -378,6 +389,8 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint> {
         obj.entry("rest_input").or_insert(serde_json::json!(false));
         obj.entry("body_contact")
             .or_insert(serde_json::json!(false));
+        // Those written before networks could grow have no extra blocks.
+        obj.entry("extra_blocks").or_insert(serde_json::json!(0));
     }
     let config: GarNetConfig =
         serde_json::from_value(config_json).map_err(|e| bad(format!("metadata config: {e}")))?;

@@ -154,7 +154,13 @@ fn checkpoints_from_before_later_fields_load_as_they_were_trained() {
     strip_checkpoint(
         &path,
         &["body.skinning", "canonical_frame"],
-        &["input_scale", "input_centre", "rest_input", "body_contact"],
+        &[
+            "input_scale",
+            "input_centre",
+            "rest_input",
+            "body_contact",
+            "extra_blocks",
+        ],
         &["units_per_metre"],
     );
     let old = load_checkpoint(&path).unwrap();
@@ -162,7 +168,7 @@ fn checkpoints_from_before_later_fields_load_as_they_were_trained() {
     assert!(!old.setup.canonical_frame);
     let c = &old.setup.config;
     assert_eq!((c.input_scale, c.input_centre.clone()), (1.0, vec![0.0; 3]));
-    assert!(!c.rest_input && !c.body_contact);
+    assert!(!c.rest_input && !c.body_contact && c.extra_blocks == 0);
     assert_eq!(old.loss.units_per_metre, 1.0);
     // The parameters are the same; only their meaning changed.
     assert_eq!(old.model(&device).unwrap().num_params(), model.num_params());
@@ -802,4 +808,51 @@ fn averaged_checkpoint_holds_the_mean_network() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("not averageable"), "{err}");
+}
+
+/// A checkpoint grown by `grow_checkpoint` drapes bit for bit as its parent, keeps its
+/// progress, and its new blocks learn: after training steps their head weights are no
+/// longer zero and the drapes differ.
+#[test]
+fn grown_checkpoint_drapes_as_its_parent_then_trains_its_new_blocks() {
+    let device = Device::flex();
+    let dir = tempfile::tempdir().unwrap();
+    let s = setup(Variant::Local, 60);
+    let data = samples(&s, 3);
+    let mut trainer = Trainer::new(s, LossConfig::new(), 1e-3, &device).unwrap();
+    for _ in 0..2 {
+        trainer.step(&data[..2]).unwrap();
+    }
+    let parent = dir.path().join("parent.garnet");
+    trainer.save(&parent).unwrap();
+    let grown = dir.path().join("grown.garnet");
+    let params = grow_checkpoint(&parent, &grown, 2, "garnet grow").unwrap();
+    let ck = load_checkpoint(&grown).unwrap();
+    assert_eq!(ck.setup.config.extra_blocks, 2);
+    assert_eq!(ck.state.step, 2);
+    assert!(!ck.has_optimizer());
+    assert!(ck.setup.config.method_name().ends_with(" +2 blocks"));
+    assert_eq!(ck.model(&device).unwrap().num_params(), params);
+
+    let pairs: Vec<(&[Vec3], &[Vec3])> =
+        data.iter().map(|d| (&d.body[..], &d.warped[..])).collect();
+    let before = Draper::load(&parent, &device)
+        .unwrap()
+        .drape_batch(&pairs)
+        .unwrap();
+    let after = Draper::load(&grown, &device)
+        .unwrap()
+        .drape_batch(&pairs)
+        .unwrap();
+    assert_eq!(bits(&before), bits(&after));
+
+    let mut more = Trainer::resume(&grown, None, &device).unwrap();
+    for _ in 0..2 {
+        more.step(&data[..2]).unwrap();
+    }
+    let w = model::tensors::read_f32(more.model().garment.extra[1].conv.w.weight.val()).unwrap();
+    assert!(w.iter().any(|&v| v != 0.0));
+    let trained = more.draper().unwrap().drape_batch(&pairs).unwrap();
+    assert_ne!(bits(&trained), bits(&after));
+    assert!(grow_checkpoint(&parent, &grown, 0, "x").is_err());
 }
