@@ -582,13 +582,12 @@ fn average_writes_a_checkpoint_that_exports() {
         "{card}"
     );
 
-    let local = tmp.path().join("local");
-    ok(&train_args(data, "local", "1", &local, &[]));
+    let local = one_epoch_checkpoint(data, "local", &tmp.path().join("local"));
     let err = fails(&[
         "average",
         "--models",
         s(&snapshots[0]),
-        s(&local.join("last.garnet")),
+        s(&local),
         "--out",
         s(&mean),
     ]);
@@ -607,10 +606,9 @@ fn grow_keeps_the_drapes_and_trains_on() {
     let data = dataset();
     let tmp = tempfile::tempdir().unwrap();
     let run = tmp.path().join("global");
-    ok(&train_args(data, "global", "1", &run, &[]));
+    let grown = one_epoch_checkpoint(data, "global", &run);
     let parent = tmp.path().join("parent.garnet");
-    std::fs::copy(run.join("last.garnet"), &parent).unwrap();
-    let grown = run.join("last.garnet");
+    std::fs::copy(&grown, &parent).unwrap();
     let log = ok(&[
         "grow",
         "--model",
@@ -648,18 +646,24 @@ fn grow_keeps_the_drapes_and_trains_on() {
         "{log}"
     );
 
-    let naive = tmp.path().join("naive");
-    ok(&train_args(data, "naive", "1", &naive, &[]));
+    let naive = one_epoch_checkpoint(data, "naive", &tmp.path().join("naive"));
     let err = fails(&[
         "grow",
         "--model",
-        s(&naive.join("last.garnet")),
+        s(&naive),
         "--extra-blocks",
         "1",
         "--out",
         s(&tmp.path().join("x.garnet")),
     ]);
     assert!(err.contains("Naive has no mesh convolutions"), "{err}");
+}
+
+/// `garnet train` of `variant` on `data`'s T-shirts for one epoch into `run`: its
+/// `last.garnet`.
+fn one_epoch_checkpoint(data: &Path, variant: &str, run: &Path) -> PathBuf {
+    ok(&train_args(data, variant, "1", run, &[]));
+    run.join("last.garnet")
 }
 
 /// `v` as the `&str` arguments [`ok`] takes.

@@ -18,6 +18,17 @@ use crate::layers::{lrelu, max_points, CondLinear};
 use crate::stn::Stn;
 use crate::topology::TopologyTensors;
 
+/// `conv` over the garment's 1-ring applied to the features `x` `[B,N,C]` concatenated with
+/// the vertex positions `pos` `[B,N,3]`: `[B,N,C_out]`.
+fn conv_with_positions(
+    conv: &FeaStConv,
+    x: Tensor<3>,
+    pos: Tensor<3>,
+    topo: &TopologyTensors,
+) -> Tensor<3> {
+    conv.forward(Tensor::cat(vec![x, pos], 2), &topo.ring, &topo.ring_weight)
+}
+
 /// A residual block of FeaStNet convolutions `C+3 -> C`, each seeing the features
 /// concatenated with the vertex positions M, LeakyReLU between them, the block input added
 /// before the last activation: with one convolution `y = lrelu(x + conv([x; M]))`, with two
@@ -50,11 +61,7 @@ impl ResBlock {
             if i > 0 {
                 h = lrelu(h);
             }
-            h = conv.forward(
-                Tensor::cat(vec![h, pos.clone()], 2),
-                &topo.ring,
-                &topo.ring_weight,
-            );
+            h = conv_with_positions(conv, h, pos.clone(), topo);
         }
         lrelu(x + h)
     }
@@ -91,12 +98,7 @@ impl ExtraBlock {
 
     /// `x` `[B,N,C]`, `pos` `[B,N,3]` -> `[B,N,C]`.
     pub fn forward(&self, x: Tensor<3>, pos: Tensor<3>, topo: &TopologyTensors) -> Tensor<3> {
-        let h = self.conv.forward(
-            Tensor::cat(vec![x.clone(), pos], 2),
-            &topo.ring,
-            &topo.ring_weight,
-        );
-        x + h
+        x.clone() + conv_with_positions(&self.conv, x, pos, topo)
     }
 }
 
