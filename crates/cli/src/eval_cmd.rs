@@ -218,6 +218,35 @@ impl ModelEvaluation {
     pub fn times(&self) -> (f64, Option<f64>) {
         (self.timing.network_ms, self.timing.simulator_s)
     }
+
+    /// Appends ` (model)` to the method name of this model's rows (not of the DQS row).
+    fn name_model(&mut self, model: &str) {
+        let suffix = format!(" ({model})");
+        let rows = [Some(&mut self.net), self.pushed.as_mut()];
+        for method in rows.into_iter().flatten().map(|r| &mut r.method) {
+            method.push_str(&suffix);
+        }
+        self.timing.method.push_str(&suffix);
+        for m in &mut self.by_motion {
+            m.add_to_method(&suffix);
+        }
+    }
+}
+
+/// Names the model file in the rows of the evaluations whose garment and method another
+/// evaluation shares (two checkpoints of one variant), so that the tables tell them apart.
+/// `evaluations[i]` is the evaluation of `models[i]`.
+fn name_repeated_methods(evaluations: &mut [ModelEvaluation], models: &[PathBuf]) {
+    let key = |e: &ModelEvaluation| (e.garment.clone(), e.timing.method.clone());
+    let mut count: HashMap<(String, String), usize> = HashMap::new();
+    for e in evaluations.iter() {
+        *count.entry(key(e)).or_default() += 1;
+    }
+    for (e, path) in evaluations.iter_mut().zip(models) {
+        if count[&key(e)] > 1 {
+            e.name_model(&path.display().to_string());
+        }
+    }
 }
 
 /// A dataset opened for evaluation: the body faces, the template body and the simulator
@@ -382,8 +411,9 @@ pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
         .save_drapes
         .as_ref()
         .map(|root| save_folders(root, &args.models));
+    let mut evaluations = Vec::new();
     for (i, path) in args.models.iter().enumerate() {
-        let e = data.evaluate(
+        evaluations.push(data.evaluate(
             path,
             &args.split,
             filter.as_ref(),
@@ -393,7 +423,10 @@ pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
                 save_drapes: save_dirs.as_ref().map(|d| d[i].as_path()),
             },
             &device,
-        )?;
+        )?);
+    }
+    name_repeated_methods(&mut evaluations, &args.models);
+    for e in evaluations {
         rows.push(e.net);
         rows.extend(e.pushed);
         if dqs_done.insert(e.garment) {

@@ -29,6 +29,13 @@ pub struct MotionRow {
     dqs_e_dist_cm: f32,
 }
 
+impl MotionRow {
+    /// Appends `suffix` to the method name.
+    pub fn add_to_method(&mut self, suffix: &str) {
+        self.method.push_str(suffix);
+    }
+}
+
 /// Drape count and summed E_dist (cm) of the network and of DQS, by motion.
 #[derive(Default)]
 pub struct ByMotion(BTreeMap<String, (usize, f64, f64)>);

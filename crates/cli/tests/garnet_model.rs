@@ -541,19 +541,20 @@ fn train_takes_the_network_widths_from_a_config_file() {
     );
 }
 
-/// `garnet average` of two epochs' checkpoints: a checkpoint that exports with a card naming
-/// the averaged epochs; checkpoints of another variant are refused.
+/// `garnet average` of two epochs' checkpoints kept by `train --keep-epochs`: a checkpoint
+/// that exports with a card naming the averaged epochs; checkpoints of another variant are
+/// refused.
 #[test]
 fn average_writes_a_checkpoint_that_exports() {
     let data = dataset();
     let tmp = tempfile::tempdir().unwrap();
     let run = tmp.path().join("naive");
-    let mut snapshots = Vec::new();
-    for epochs in ["1", "2"] {
-        ok(&train_args(data, "naive", epochs, &run, &["--resume"]));
-        let snap = tmp.path().join(format!("epoch-{epochs}.garnet"));
-        std::fs::copy(run.join("last.garnet"), &snap).unwrap();
-        snapshots.push(snap);
+    ok(&train_args(data, "naive", "2", &run, &["--keep-epochs"]));
+    let snapshots: Vec<PathBuf> = (1..=2)
+        .map(|e| run.join(format!("epoch-{e}.garnet")))
+        .collect();
+    for (e, snap) in snapshots.iter().enumerate() {
+        assert_eq!(model::load_checkpoint(snap).unwrap().state.epoch, e + 1);
     }
     let mean = tmp.path().join("mean.garnet");
     let log = ok(&[
@@ -565,6 +566,18 @@ fn average_writes_a_checkpoint_that_exports() {
         s(&mean),
     ]);
     assert!(log.contains("the mean of 2 networks"), "{log}");
+    // Three networks of one variant: each row names its file (Tables 1 and 2 and the one
+    // motion of the split); the DQS row stays one.
+    let eval = tmp.path().join("eval");
+    let mut args = vec!["eval", "--data", s(data), "--model"];
+    args.extend([s(&snapshots[0]), s(&snapshots[1]), s(&mean)]);
+    args.extend(["--out", s(&eval)]);
+    let md = ok(&args);
+    for model in [&snapshots[0], &snapshots[1], &mean] {
+        let row = format!("| tshirt | GarNet-naive ({}) |", model.display());
+        assert_eq!(md.matches(&row).count(), 3, "{row}\n{md}");
+    }
+    assert_eq!(md.matches("| tshirt | DQS |").count(), 1, "{md}");
     let card_model = tmp.path().join("models").join("tshirt-naive.garnet");
     ok(&[
         "export",
@@ -666,7 +679,6 @@ fn one_epoch_checkpoint(data: &Path, variant: &str, run: &Path) -> PathBuf {
     run.join("last.garnet")
 }
 
-/// `v` as the `&str` arguments [`ok`] takes.
 /// `garnet train` on `data`'s T-shirts with `variant` for `epochs` into `out`, then `extra`.
 fn train_args<'a>(
     data: &'a Path,

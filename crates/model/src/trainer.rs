@@ -29,6 +29,12 @@ pub const BEST_CHECKPOINT: &str = "best.garnet";
 /// File name of the per-epoch metrics log.
 pub const METRICS_LOG: &str = "metrics.csv";
 
+/// File name of the checkpoint that [`Trainer::set_keep_epochs`] keeps of epoch `epoch`
+/// (1-based, as in `metrics.csv`): `epoch-N.garnet`.
+pub fn epoch_checkpoint_name(epoch: usize) -> String {
+    format!("epoch-{epoch}.garnet")
+}
+
 /// Validation results averaged over samples.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Validation {
@@ -80,6 +86,8 @@ pub struct Trainer {
     mirror: Option<MirrorMap>,
     /// The name of the validation set of this run (see [`Trainer::set_validation_set`]).
     validation_set: Option<String>,
+    /// Whether each epoch also writes its own checkpoint (see [`epoch_checkpoint_name`]).
+    keep_epochs: bool,
     device: Device,
 }
 
@@ -159,6 +167,7 @@ impl Trainer {
             state,
             mirror: None,
             validation_set: None,
+            keep_epochs: false,
             device,
         };
         trainer.set_mirror(trainer.state.mirror)?;
@@ -199,6 +208,14 @@ impl Trainer {
             }
             _ => None,
         }
+    }
+
+    /// When `keep` is set, every epoch of [`Trainer::run_epoch`] also writes its checkpoint
+    /// (network, Adam state and progress, as `last.garnet`) to
+    /// `out_dir/`[`epoch_checkpoint_name`]: the snapshots that `garnet average` averages
+    /// and that a run can branch from (copy one to another folder's `last.garnet`).
+    pub fn set_keep_epochs(&mut self, keep: bool) {
+        self.keep_epochs = keep;
     }
 
     /// The learning rate.
@@ -398,8 +415,8 @@ impl Trainer {
 
     /// One epoch: trains on `train`, validates on `valid` (when given), advances the epoch
     /// counter, writes `out_dir/last.garnet`, `out_dir/best.garnet` when validation E_dist
-    /// improved (or, without validation, every epoch), and appends a row to
-    /// `out_dir/metrics.csv`.
+    /// improved (or, without validation, every epoch), `out_dir/epoch-N.garnet` when
+    /// [`Trainer::set_keep_epochs`] is on, and appends a row to `out_dir/metrics.csv`.
     pub fn run_epoch<I, J, E>(
         &mut self,
         train: I,
@@ -440,6 +457,9 @@ impl Trainer {
         self.save(&out_dir.join(LAST_CHECKPOINT))?;
         if is_best {
             self.save(&out_dir.join(BEST_CHECKPOINT))?;
+        }
+        if self.keep_epochs {
+            self.save(&out_dir.join(epoch_checkpoint_name(self.state.epoch)))?;
         }
         let seconds = start.elapsed().as_secs_f64();
         let row = MetricsRow {

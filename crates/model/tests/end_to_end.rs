@@ -750,6 +750,48 @@ fn best_starts_afresh_on_another_validation_set() {
     assert_eq!(state.epoch, 2);
 }
 
+/// `set_keep_epochs` writes every epoch's checkpoint beside `last.garnet`; a run branched
+/// from one of them (copied to another folder's `last.garnet`) takes the trunk's next steps
+/// bit for bit, and a run without the option keeps none.
+#[test]
+fn kept_epochs_are_checkpoints_to_branch_from() {
+    use model::trainer::epoch_checkpoint_name;
+    let device = Device::flex();
+    let trunk = tempfile::tempdir().unwrap();
+    let s = setup(Variant::Global, 40);
+    let data = samples(&s, 2);
+    let train = || vec![Ok::<_, String>(data.clone())];
+    let mut trainer = Trainer::new(s.clone(), LossConfig::new(), 1e-3, &device).unwrap();
+    trainer.set_keep_epochs(true);
+    trainer
+        .fit(2, |_| train(), NO_VALIDATION, trunk.path(), |_| {})
+        .unwrap();
+    let params = |path: &std::path::Path| {
+        let ck = load_checkpoint(path).unwrap();
+        (
+            ck.state.epoch,
+            model::average::parameter_values(&ck.model(&device).unwrap()).unwrap(),
+        )
+    };
+    let (last, _, _) = Trainer::output_paths(trunk.path());
+    let kept: Vec<_> = (1..=2)
+        .map(|e| params(&trunk.path().join(epoch_checkpoint_name(e))))
+        .collect();
+    assert_eq!(kept[0].0, 1);
+    assert_eq!(kept[1], params(&last));
+    assert_ne!(kept[0].1, kept[1].1);
+
+    let branch = tempfile::tempdir().unwrap();
+    let (branch_last, _, _) = Trainer::output_paths(branch.path());
+    std::fs::copy(trunk.path().join(epoch_checkpoint_name(1)), &branch_last).unwrap();
+    let mut resumed = Trainer::resume(&branch_last, None, &device).unwrap();
+    resumed
+        .fit(2, |_| train(), NO_VALIDATION, branch.path(), |_| {})
+        .unwrap();
+    assert_eq!(params(&branch_last), kept[1]);
+    assert!(!branch.path().join(epoch_checkpoint_name(2)).exists());
+}
+
 /// No validation data, for [`Trainer::fit`].
 const NO_VALIDATION: Option<fn() -> Vec<Result<Vec<Sample>, String>>> = None;
 
