@@ -793,7 +793,10 @@ fn kept_epochs_are_checkpoints_to_branch_from() {
 }
 
 /// No validation data, for [`Trainer::fit`].
-const NO_VALIDATION: Option<fn() -> Vec<Result<Vec<Sample>, String>>> = None;
+const NO_VALIDATION: Option<fn() -> SampleBatches> = None;
+
+/// Batches of samples as [`Trainer::fit`] takes them.
+type SampleBatches = Vec<Result<Vec<Sample>, String>>;
 
 /// `average_checkpoints` writes the mean network with the last input's progress, the
 /// averaged epochs and no best figure; checkpoints of other setups are refused.
