@@ -6,6 +6,7 @@ use std::time::Instant;
 use burn::prelude::*;
 use glam::Vec3;
 use model::synthetic::{synthetic_sample, tube_garment};
+use model::trainer::epoch_checkpoint_name;
 use model::*;
 
 const N_BODY: usize = 240;
@@ -755,23 +756,17 @@ fn best_starts_afresh_on_another_validation_set() {
 /// bit for bit, and a run without the option keeps none.
 #[test]
 fn kept_epochs_are_checkpoints_to_branch_from() {
-    use model::trainer::epoch_checkpoint_name;
     let device = Device::flex();
     let trunk = tempfile::tempdir().unwrap();
-    let s = setup(Variant::Global, 40);
-    let data = samples(&s, 2);
+    let (mut trainer, data) = global_trainer_on_two_samples(&device);
     let train = || vec![Ok::<_, String>(data.clone())];
-    let mut trainer = Trainer::new(s.clone(), LossConfig::new(), 1e-3, &device).unwrap();
     trainer.set_keep_epochs(true);
     trainer
         .fit(2, |_| train(), NO_VALIDATION, trunk.path(), |_| {})
         .unwrap();
     let params = |path: &std::path::Path| {
-        let ck = load_checkpoint(path).unwrap();
-        (
-            ck.state.epoch,
-            model::average::parameter_values(&ck.model(&device).unwrap()).unwrap(),
-        )
+        let epoch = load_checkpoint(path).unwrap().state.epoch;
+        (epoch, checkpoint_params(path, &device))
     };
     let (last, _, _) = Trainer::output_paths(trunk.path());
     let kept: Vec<_> = (1..=2)
@@ -798,27 +793,38 @@ const NO_VALIDATION: Option<fn() -> SampleBatches> = None;
 /// Batches of samples as [`Trainer::fit`] takes them.
 type SampleBatches = Vec<Result<Vec<Sample>, String>>;
 
+/// A fresh GarNet-Global trainer (Adam at 1e-3) on a 40-vertex tube, and two samples of it.
+fn global_trainer_on_two_samples(device: &Device) -> (Trainer, Vec<Sample>) {
+    let s = setup(Variant::Global, 40);
+    let data = samples(&s, 2);
+    (
+        Trainer::new(s, LossConfig::new(), 1e-3, device).unwrap(),
+        data,
+    )
+}
+
+/// The parameter values of the network in the checkpoint at `path`.
+fn checkpoint_params(path: &std::path::Path, device: &Device) -> Vec<model::average::ParamValues> {
+    model::average::parameter_values(&load_checkpoint(path).unwrap().model(device).unwrap())
+        .unwrap()
+}
+
 /// `average_checkpoints` writes the mean network with the last input's progress, the
 /// averaged epochs and no best figure; checkpoints of other setups are refused.
 #[test]
 fn averaged_checkpoint_holds_the_mean_network() {
     let device = Device::flex();
     let dir = tempfile::tempdir().unwrap();
-    let s = setup(Variant::Global, 40);
-    let data = samples(&s, 2);
+    let (mut trainer, data) = global_trainer_on_two_samples(&device);
     let train = || vec![Ok::<_, String>(data.clone())];
-    let mut trainer = Trainer::new(s.clone(), LossConfig::new(), 1e-3, &device).unwrap();
     trainer.set_command("garnet train x".into());
-    let (last, _, _) = Trainer::output_paths(dir.path());
-    let mut snapshots = Vec::new();
-    for epoch in 1..=3 {
-        trainer
-            .fit(epoch, |_| train(), NO_VALIDATION, dir.path(), |_| {})
-            .unwrap();
-        let snap = dir.path().join(format!("epoch-{epoch}.garnet"));
-        std::fs::copy(&last, &snap).unwrap();
-        snapshots.push(snap);
-    }
+    trainer.set_keep_epochs(true);
+    trainer
+        .fit(3, |_| train(), NO_VALIDATION, dir.path(), |_| {})
+        .unwrap();
+    let snapshots: Vec<_> = (1..=3)
+        .map(|e| dir.path().join(epoch_checkpoint_name(e)))
+        .collect();
     let inputs: Vec<&std::path::Path> = snapshots.iter().map(|p| p.as_path()).collect();
     let out = dir.path().join("mean.garnet");
     let report = average_checkpoints(&inputs, &out, "garnet average").unwrap();
@@ -839,7 +845,7 @@ fn averaged_checkpoint_holds_the_mean_network() {
         .map(|p| load_checkpoint(p).unwrap().model(&device).unwrap())
         .collect();
     let expected = model::average::parameter_values(&average_networks(&nets).unwrap()).unwrap();
-    let got = model::average::parameter_values(&mean.model(&device).unwrap()).unwrap();
+    let got = checkpoint_params(&out, &device);
     assert_eq!(got, expected);
     assert_ne!(got, model::average::parameter_values(&nets[2]).unwrap());
 
