@@ -233,7 +233,10 @@ fn generate(args: &GenerateArgs) -> anyhow::Result<()> {
     );
     let state = match (report.complete, report.finished) {
         (true, _) => "the dataset is complete",
-        (false, true) => "the selected shards are finished; merge the job folders",
+        (false, true) => {
+            "the selected shards are finished; the dataset's other shards are still to be made \
+             (another --shard range) or merged in from the folders that hold them (dataset merge)"
+        }
         (false, false) => "stopped before the end: run the same command again to resume",
     };
     println!("{}: {state}", args.out.display());

@@ -191,8 +191,8 @@ fn model_card(
          - command: `{cmd}`\n\
          - progress: {ep} epochs, {st} steps, last learning rate {lr:.1e}; best validation E_dist \
          {best}\n\
-         - loss: L_vertex + {pen} L_pen + {norm} L_norm + {bend} L_bend, lengths in {unit}, \
-         d_tol {dtol} m\n{clip}{mirror}{history}\n",
+         - loss: {vertex}L_vertex (mean of {vertex_name}) + {pen} L_pen + {norm} L_norm + {bend} L_bend, lengths in \
+         {unit}, d_tol {dtol} m\n{vertex_history}{clip}{mirror}{history}\n",
         train = trained_on,
         ds = train.manifest().spec.name,
         dir = train.dir().display(),
@@ -206,6 +206,18 @@ fn model_card(
         best = state
             .best_e_dist_cm
             .map_or("n/a".to_string(), |b| format!("{b:.2} cm")),
+        vertex = if loss.vertex == 1.0 {
+            String::new()
+        } else {
+            format!("{} ", loss.vertex)
+        },
+        vertex_name = vertex_loss_name(loss.vertex_power),
+        vertex_history = metrics_csv
+            .as_deref()
+            .and_then(vertex_power_history)
+            .map_or(String::new(), |h| format!(
+                "- L_vertex averaged, by epoch (from the run's metrics.csv): {h}\n"
+            )),
         pen = loss.pen,
         norm = loss.norm,
         bend = loss.bend,
@@ -334,26 +346,73 @@ fn learning_rate_history(csv: &str, averaged: bool) -> Option<String> {
 /// with the same count: `1229 (epochs 1-30), 1500 (epochs 31-45)`; `None` for a log without
 /// rows.
 fn training_samples_history(csv: &str) -> Option<String> {
-    // (first epoch, last epoch, samples)
-    let mut runs: Vec<(usize, usize, u64)> = Vec::new();
-    for line in csv.lines().skip(1) {
-        let f: Vec<&str> = line.split(',').collect();
-        let (Some(epoch), Some(n)) = (
-            f.first().and_then(|e| e.parse().ok()),
-            f.get(4).and_then(|n| n.parse().ok()),
-        ) else {
-            continue;
-        };
-        match runs.last_mut() {
-            Some(r) if r.2 == n => r.1 = epoch,
-            _ => runs.push((epoch, epoch, n)),
-        }
+    let text: Vec<String> = column_runs(csv, "train_samples", None)
+        .iter()
+        .map(|(a, b, n)| format!("{n} ({})", epoch_span(*a, *b)))
+        .collect();
+    (!text.is_empty()).then(|| text.join(", "))
+}
+
+/// What L_vertex averaged, by epoch, from a training log (`metrics.csv` text):
+/// `squared distances (epochs 1-84), distances (epochs 85-89)`; `None` when every epoch
+/// used the paper's squared distances (rows logged before the column existed did).
+fn vertex_power_history(csv: &str) -> Option<String> {
+    let runs = column_runs(csv, "vertex_power", Some("2"));
+    if runs.iter().all(|r| r.2 == "2") {
+        return None;
     }
     let text: Vec<String> = runs
         .iter()
-        .map(|&(a, b, n)| format!("{n} ({})", epoch_span(a, b)))
+        .map(|(a, b, p)| {
+            let what = p
+                .parse()
+                .map_or_else(|_| format!("power {p}"), vertex_loss_name);
+            format!("{what} ({})", epoch_span(*a, *b))
+        })
         .collect();
-    (!text.is_empty()).then(|| text.join(", "))
+    Some(text.join(", "))
+}
+
+/// What L_vertex averages with distances to the power `p`: `squared distances` (2),
+/// `distances` (1), `distances to the power 1.5`.
+fn vertex_loss_name(p: f64) -> String {
+    match p {
+        2.0 => "squared distances".into(),
+        1.0 => "distances".into(),
+        p => format!("distances to the power {p}"),
+    }
+}
+
+/// Runs of epochs with the same value in the column named `name` of a training log
+/// (`metrics.csv` text), as (first epoch, last epoch, value); an empty or missing field
+/// reads as `empty` (a row logged before the column existed), or skips the row when that is
+/// `None`.
+fn column_runs(csv: &str, name: &str, empty: Option<&str>) -> Vec<(usize, usize, String)> {
+    let Some(col) = model::metrics_log::HEADER
+        .split(',')
+        .position(|c| c == name)
+    else {
+        return Vec::new();
+    };
+    let mut runs: Vec<(usize, usize, String)> = Vec::new();
+    for line in csv.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let value = match f.get(col).filter(|v| !v.is_empty()) {
+            Some(v) => *v,
+            None => match empty {
+                Some(e) => e,
+                None => continue,
+            },
+        };
+        let Some(epoch) = f.first().and_then(|e| e.parse().ok()) else {
+            continue;
+        };
+        match runs.last_mut() {
+            Some(r) if r.2 == value => r.1 = epoch,
+            _ => runs.push((epoch, epoch, value.to_string())),
+        }
+    }
+    runs
 }
 
 /// `epoch A` or `epochs A-B`.
@@ -379,7 +438,9 @@ fn epoch_list(epochs: &[usize]) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{epoch_list, learning_rate_history, training_samples_history};
+    use super::{
+        epoch_list, learning_rate_history, training_samples_history, vertex_power_history,
+    };
 
     #[test]
     fn learning_rates_fold_into_constant_and_falling_segments() {
@@ -431,5 +492,23 @@ mod tests {
             "1229 (epochs 1-3), 1500 (epochs 4-5), 7 (epoch 6)"
         );
         assert_eq!(training_samples_history(header), None);
+    }
+
+    /// Rows logged before the column existed read as squared distances; a log that never
+    /// changed the power says nothing.
+    #[test]
+    fn vertex_powers_fold_into_runs_and_old_rows_read_as_squared() {
+        let header = model::metrics_log::HEADER;
+        let base = |e: usize| format!("{e},0,1e-4,1.0,8,1,1,0,0,0,2,1,1,0,0,0,3.5,20,0");
+        let mut csv = format!("{header}\n{}\n", base(1));
+        csv += &format!("{},100,2\n", base(2));
+        assert_eq!(vertex_power_history(&csv), None);
+        csv += &format!("{},100,1\n{},100,1\n", base(3), base(4));
+        csv += &format!("{},100,1.5\n", base(5));
+        assert_eq!(
+            vertex_power_history(&csv).unwrap(),
+            "squared distances (epochs 1-2), distances (epochs 3-4), distances to the power \
+             1.5 (epoch 5)"
+        );
     }
 }

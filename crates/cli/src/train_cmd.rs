@@ -80,6 +80,18 @@ pub struct TrainArgs {
     /// See --no-pen.
     #[arg(long)]
     pub no_bend: bool,
+    /// L_vertex averages each vertex's distance to this power, in [1, 2]: 2 is the paper's
+    /// squared distance, 1 the distance itself (what E_dist reports; far-off vertices of
+    /// poorly settled drapes pull no harder than the rest). Given with --resume, it changes
+    /// the resumed run's loss from then on (a fine-tune); otherwise a resumed run keeps its
+    /// loss.
+    #[arg(long, value_name = "P")]
+    pub vertex_power: Option<f64>,
+    /// Weight of L_vertex (the paper: 1; the other weights stay the paper's). With
+    /// --vertex-power 1 in cm, a weight of 2 pulls a vertex 1 cm off as hard as the squared
+    /// loss does. With --resume, as --vertex-power.
+    #[arg(long, value_name = "W")]
+    pub vertex_weight: Option<f64>,
     /// Length unit of the loss terms (the paper's weights balance them in centimetres).
     #[arg(long, value_enum, default_value_t = LossUnit::Cm)]
     pub loss_unit: LossUnit,
@@ -252,7 +264,8 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
     });
     let device = args.device.device()?;
     let last = out.join(model::trainer::LAST_CHECKPOINT);
-    let mut trainer = if args.resume && last.is_file() {
+    let resumed = args.resume && last.is_file();
+    let mut trainer = if resumed {
         eprintln!("resuming from {}", last.display());
         let trainer = Trainer::resume(&last, Some(args.lr), &device)
             .with_context(|| format!("resuming {}", last.display()))?;
@@ -286,6 +299,18 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
     }
     if args.grad_clip.is_some() {
         trainer.set_max_grad_norm(args.grad_clip)?;
+    }
+    if resumed && (args.vertex_power.is_some() || args.vertex_weight.is_some()) {
+        let loss = with_vertex_args(trainer.loss_config().clone(), args);
+        eprintln!(
+            "L_vertex from here on: weight {}, distances to the power {} (the checkpoint's: \
+             weight {}, power {})",
+            loss.vertex,
+            loss.vertex_power,
+            trainer.loss_config().vertex,
+            trainer.loss_config().vertex_power
+        );
+        trainer.set_loss_config(loss)?;
     }
     if args.mirror {
         trainer
@@ -407,7 +432,8 @@ pub fn check_body_skinning(
     Ok(())
 }
 
-/// The paper's loss weights, with the terms `args` turned off set to zero.
+/// The paper's loss weights, with the terms `args` turned off set to zero and L_vertex's
+/// power and weight from `args`.
 fn loss_config(args: &TrainArgs) -> LossConfig {
     let mut cfg = LossConfig::new();
     cfg.units_per_metre = match args.loss_unit {
@@ -422,6 +448,17 @@ fn loss_config(args: &TrainArgs) -> LossConfig {
     }
     if args.no_bend {
         cfg.bend = 0.0;
+    }
+    with_vertex_args(cfg, args)
+}
+
+/// `cfg` with L_vertex's power and weight from `args` where given.
+fn with_vertex_args(mut cfg: LossConfig, args: &TrainArgs) -> LossConfig {
+    if let Some(p) = args.vertex_power {
+        cfg.vertex_power = p;
+    }
+    if let Some(w) = args.vertex_weight {
+        cfg.vertex = w;
     }
     cfg
 }

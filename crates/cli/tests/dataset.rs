@@ -148,7 +148,8 @@ fn generate_resume_merge_info_show() {
         out.contains("1 of 4 selected samples were already made"),
         "{out}"
     );
-    assert!(out.contains("merge the job folders"), "{out}");
+    assert!(out.contains("the selected shards are finished"), "{out}");
+    assert!(out.contains("(dataset merge)"), "{out}");
     ok(&[
         "dataset",
         "generate",

@@ -88,16 +88,29 @@ fn train_resume_eval_and_drape() {
     for f in ["best.garnet", "last.garnet"] {
         assert!(local.join(f).is_file(), "{f}");
     }
-    // Resume to three epochs: one more row.
+    // Resume to three epochs with L_vertex as the mean distance: one more row.
     let mut resume = args("3");
-    resume.push("--resume".into());
+    resume.extend(["--resume", "--vertex-power", "1", "--vertex-weight", "2"].map(String::from));
     let log = ok(&as_str(&resume));
     // The resumed run keeps mirroring without being told again.
     assert!(
         log.contains("resuming") && log.contains("mirroring every other training sample"),
         "{log}"
     );
+    assert!(
+        log.contains("L_vertex from here on: weight 2, distances to the power 1 (the checkpoint's: weight 1, power 2)"),
+        "{log}"
+    );
     assert_eq!(rows(&metrics), 4);
+    let powers: Vec<String> = std::fs::read_to_string(&metrics)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.rsplit(',').next().unwrap().to_string())
+        .collect();
+    assert_eq!(powers, ["2", "2", "1"]);
+    let resumed = model::load_checkpoint(&local.join("last.garnet")).unwrap();
+    assert_eq!((resumed.loss.vertex, resumed.loss.vertex_power), (2.0, 1.0));
 
     // Naive with clipped gradients and a cosine schedule over two epochs.
     let naive = tmp.path().join("naive");
@@ -116,7 +129,11 @@ fn train_resume_eval_and_drape() {
         "{log}"
     );
     let csv = std::fs::read_to_string(naive.join("metrics.csv")).unwrap();
-    assert!(csv.lines().next().unwrap().ends_with(",train_grad_norm"));
+    assert!(csv
+        .lines()
+        .next()
+        .unwrap()
+        .ends_with(",train_grad_norm,vertex_power"));
 
     // Table 1 / Table 2 / precision curves.
     let eval = tmp.path().join("eval");
@@ -190,6 +207,10 @@ fn train_resume_eval_and_drape() {
         "best validation E_dist",
         "every other training sample mirrored left-right",
         "learning rate by epoch (from the run's metrics.csv): 1.0e-3 (epochs 1-3)",
+        // The best checkpoint is epoch 2's, before the resumed run changed the loss.
+        "- loss: L_vertex (mean of squared distances) + 1 L_pen",
+        "L_vertex averaged, by epoch (from the run's metrics.csv): squared distances \
+         (epochs 1-2), distances (epoch 3)",
         // The drapes it was trained on (from the run's log), those the export's filter
         // passes, and its metrics on the test drapes that pass it.
         "2 training samples of this garment, 2 of them drapes with strain p99 at most 1000%",
@@ -355,6 +376,11 @@ fn train_and_eval_leave_out_drapes_not_at_rest_or_overstretched() {
     ok(&as_str(&eval(&["--max-slide", "1000"])));
     let err = fails(&as_str(&train(&["--max-slide=-1"])));
     assert!(err.contains("--max-slide"), "{err}");
+    let err = fails(&as_str(&train(&["--vertex-power", "3"])));
+    assert!(
+        err.contains("the power of L_vertex's distances must be in [1, 2], got 3"),
+        "{err}"
+    );
 }
 
 #[test]

@@ -400,6 +400,8 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint> {
     if let Some(obj) = loss_json.as_object_mut() {
         obj.entry("units_per_metre")
             .or_insert(serde_json::json!(1.0));
+        // Those written before L_vertex had a power used the paper's squared distance.
+        obj.entry("vertex_power").or_insert(serde_json::json!(2.0));
     }
     let loss: LossConfig =
         serde_json::from_value(loss_json).map_err(|e| bad(format!("metadata loss: {e}")))?;

@@ -3,10 +3,11 @@
 //! ```text
 //! epoch,step,lr,seconds,train_samples,train_total,train_vertex,train_pen,train_norm,
 //! train_bend,val_samples,val_total,val_vertex,val_pen,val_norm,val_bend,val_e_dist_cm,
-//! val_e_norm_deg,best,train_grad_norm
+//! val_e_norm_deg,best,train_grad_norm,vertex_power
 //! ```
 //!
-//! Loss terms in the loss's units (cm by default: vertex cm^2, pen and bend cm, norm none);
+//! Loss terms in the loss's units (cm by default: vertex cm^2, pen and bend cm, norm none;
+//! vertex in cm^p with the epoch's `vertex_power` p, see `LossConfig::vertex_power`);
 //! the `val_*` fields are empty for an epoch without validation; `best` is 1 when the epoch
 //! wrote `best.garnet`; `train_grad_norm` is the epoch's mean joint gradient norm before
 //! clipping. Appending a row drops any rows of that epoch or later (a resumed run rewrites
@@ -22,7 +23,7 @@ use crate::trainer::Validation;
 /// The CSV header line.
 pub const HEADER: &str = "epoch,step,lr,seconds,train_samples,train_total,train_vertex,\
 train_pen,train_norm,train_bend,val_samples,val_total,val_vertex,val_pen,val_norm,val_bend,\
-val_e_dist_cm,val_e_norm_deg,best,train_grad_norm";
+val_e_dist_cm,val_e_norm_deg,best,train_grad_norm,vertex_power";
 
 /// One epoch's row.
 #[derive(Clone, Debug, PartialEq)]
@@ -45,6 +46,8 @@ pub struct MetricsRow {
     pub validation: Option<Validation>,
     /// Whether the epoch wrote the best checkpoint.
     pub is_best: bool,
+    /// The power of the distances L_vertex averaged (2: squared).
+    pub vertex_power: f64,
 }
 
 impl MetricsRow {
@@ -79,7 +82,7 @@ impl MetricsRow {
             None => s.push_str(",,,,,,,,"),
         }
         s.push_str(if self.is_best { "1," } else { "0," });
-        s.push_str(&self.grad_norm.to_string());
+        s.push_str(&format!("{},{}", self.grad_norm, self.vertex_power));
         s
     }
 }
@@ -153,6 +156,7 @@ mod tests {
                 samples: 2,
             }),
             is_best: val,
+            vertex_power: 2.0,
         }
     }
 
@@ -173,23 +177,23 @@ mod tests {
         assert!(lines.iter().all(|l| l.split(',').count() == cols));
         assert!(lines[1].starts_with("1,10,0.001,1.500,8,0.5,0.25,0,0.1,0.2,2,"));
         assert!(lines[2].starts_with("2,20,"));
-        assert!(lines[2].ends_with(",1.25,9.5,1,2.5"));
-        assert!(row(4, false).to_csv().ends_with(",,,,,,,,0,2.5"));
+        assert!(lines[2].ends_with(",1.25,9.5,1,2.5,2"));
+        assert!(row(4, false).to_csv().ends_with(",,,,,,,,0,2.5,2"));
     }
 
     #[test]
-    fn rows_of_an_older_log_get_the_new_column_empty() {
+    fn rows_of_an_older_log_get_the_new_columns_empty() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("m.csv");
-        let old_header = HEADER.trim_end_matches(",train_grad_norm");
+        let old_header = HEADER.trim_end_matches(",train_grad_norm,vertex_power");
         let old_row = row(1, true).to_csv();
-        let old_row = old_row.trim_end_matches(",2.5");
+        let old_row = old_row.trim_end_matches(",2.5,2");
         std::fs::write(&path, format!("{old_header}\n{old_row}\n")).unwrap();
         MetricsLog::new(path.clone()).append(&row(2, true)).unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(lines[0], HEADER);
-        assert_eq!(lines[1], format!("{old_row},"));
+        assert_eq!(lines[1], format!("{old_row},,"));
         let cols = HEADER.split(',').count();
         assert!(lines.iter().all(|l| l.split(',').count() == cols));
     }

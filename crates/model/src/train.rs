@@ -24,7 +24,8 @@ pub fn adam() -> ModuleOptimizer {
 }
 
 impl LossConfig {
-    /// Fails when a weight or constant is negative or not finite, or every weight is 0.
+    /// Fails when a weight or constant is negative or not finite, the power of L_vertex is
+    /// outside [1, 2], or every weight is 0.
     pub fn validate(&self) -> Result<()> {
         let all = [
             self.vertex,
@@ -43,6 +44,12 @@ impl LossConfig {
             return Err(ModelError::InvalidInput(format!(
                 "the loss unit must be a positive number of units per metre, got {}",
                 self.units_per_metre
+            )));
+        }
+        if !(1.0..=2.0).contains(&self.vertex_power) {
+            return Err(ModelError::InvalidInput(format!(
+                "the power of L_vertex's distances must be in [1, 2], got {}",
+                self.vertex_power
             )));
         }
         if self.vertex + self.pen + self.norm + self.bend == 0.0 {

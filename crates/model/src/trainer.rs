@@ -241,6 +241,15 @@ impl Trainer {
         Ok(())
     }
 
+    /// Trains the next steps with `loss` instead of the loss the run began with (to change
+    /// L_vertex's power or weight in a fine-tune, see [`LossConfig::vertex_power`]); stored
+    /// in the checkpoints, so a resumed run keeps it. Fails when `loss` is not valid.
+    pub fn set_loss_config(&mut self, loss: LossConfig) -> Result<()> {
+        loss.validate()?;
+        self.loss = loss;
+        Ok(())
+    }
+
     /// Mirrors every other training sample left-right from the next step on (`true`), or
     /// none (`false`); stored in the checkpoints, so a resumed run keeps it. Mirrored
     /// samples double the drapes the network sees (see [`crate::mirror`]). Fails when the
@@ -472,6 +481,7 @@ impl Trainer {
             grad_norm,
             validation,
             is_best,
+            vertex_power: self.loss.vertex_power,
         };
         MetricsLog::new(out_dir.join(METRICS_LOG)).append(&row)?;
         Ok(EpochReport {

@@ -139,8 +139,8 @@ fn strip_checkpoint(
 }
 
 /// Checkpoints written before a field existed load with what they were trained with:
-/// positions in metres (input unit 1, centre 0), loss in metres, no extra inputs, no
-/// canonical frame, DQS bodies.
+/// positions in metres (input unit 1, centre 0), loss in metres with squared distances, no
+/// extra inputs, no canonical frame, DQS bodies.
 #[test]
 fn checkpoints_from_before_later_fields_load_as_they_were_trained() {
     let device = Device::flex();
@@ -162,7 +162,7 @@ fn checkpoints_from_before_later_fields_load_as_they_were_trained() {
             "body_contact",
             "extra_blocks",
         ],
-        &["units_per_metre"],
+        &["units_per_metre", "vertex_power"],
     );
     let old = load_checkpoint(&path).unwrap();
     assert_eq!(old.setup.body_skinning, "dqs");
@@ -171,6 +171,7 @@ fn checkpoints_from_before_later_fields_load_as_they_were_trained() {
     assert_eq!((c.input_scale, c.input_centre.clone()), (1.0, vec![0.0; 3]));
     assert!(!c.rest_input && !c.body_contact && c.extra_blocks == 0);
     assert_eq!(old.loss.units_per_metre, 1.0);
+    assert_eq!(old.loss.vertex_power, 2.0);
     // The parameters are the same; only their meaning changed.
     assert_eq!(old.model(&device).unwrap().num_params(), model.num_params());
 }
