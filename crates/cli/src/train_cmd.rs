@@ -290,7 +290,14 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
             .with_body_faces(train.topology.faces.clone())?;
         Trainer::new(setup, loss_config(args), args.lr, &device)?
     };
-    let validation_set = format!("{}:{}", data.manifest().spec.name, args.garment);
+    // The count is part of the name: a dataset still being generated grows its validation
+    // split, and a best figure measured on fewer drapes cannot be compared.
+    let validation_set = format!(
+        "{}:{}:{}",
+        data.manifest().spec.name,
+        args.garment,
+        valid.as_ref().map_or(0, |v| v.indices.len())
+    );
     if let Some(old) = trainer.set_validation_set(&validation_set) {
         eprintln!(
             "the checkpoint's best validation E_dist ({old:.3} cm) was measured on another \

@@ -383,6 +383,43 @@ fn train_and_eval_leave_out_drapes_not_at_rest_or_overstretched() {
     );
 }
 
+/// Regression (session 26): a run on a dataset still being generated kept comparing its
+/// best validation E_dist with a figure measured before the validation split had grown.
+#[test]
+fn best_starts_afresh_when_the_validation_split_grows() {
+    let tmp = tempfile::tempdir().unwrap();
+    let spec = tmp.path().join("spec.toml");
+    // One sample a shard: shards 0-1 train, 2-3 test, 4-5 validation.
+    std::fs::write(&spec, SPEC.replace("shard_size = 2", "shard_size = 1")).unwrap();
+    let data = tmp.path().join("data");
+    let generate = |shards: &str| {
+        ok(&[
+            "dataset",
+            "generate",
+            s(&spec),
+            "--out",
+            s(&data),
+            "--shard",
+            shards,
+        ])
+    };
+    generate("0-4");
+    let run = tmp.path().join("run");
+    let log = ok(&train_args(&data, "naive", "1", &run, &[]));
+    assert!(log.contains("(1 validation)"), "{log}");
+    generate("5");
+    let log = ok(&train_args(&data, "naive", "2", &run, &["--resume"]));
+    assert!(
+        log.contains("(2 validation)")
+            && log.contains("was measured on another validation set")
+            && log.contains("validates on 'model-cli:tshirt:2'"),
+        "{log}"
+    );
+    // Resumed again on the same drapes, it keeps its best.
+    let log = ok(&train_args(&data, "naive", "3", &run, &["--resume"]));
+    assert!(!log.contains("another validation set"), "{log}");
+}
+
 #[test]
 fn drape_and_eval_refuse_what_does_not_fit() {
     let data = dataset();
