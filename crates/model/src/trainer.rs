@@ -194,7 +194,7 @@ impl Trainer {
         self.state.command = Some(command);
     }
 
-    /// Names this run's validation set (say `standard-x3-lbs:tshirt`). A best validation
+    /// Names this run's validation set (say `standard-x3-lbs:tshirt:240`). A best validation
     /// E_dist that the checkpoint says was measured on another set does not compare with
     /// this run's: it is cleared, so the next validated epoch writes `best.garnet`, and
     /// returned. A best that a checkpoint carries without its set's name (written before

@@ -530,7 +530,8 @@ fn trainer_writes_checkpoints_and_metrics_and_resumes() {
     let text = std::fs::read_to_string(&metrics).unwrap();
     assert_eq!(text.lines().count(), 3);
     assert_eq!(trainer.state().step, 4);
-    // The schedule sets each epoch's rate; every step reports its gradient norm.
+    // The schedule sets each epoch's rate; every step reports its gradient norm, and the
+    // log its L_vertex power.
     assert_eq!(reports[0].lr, 1e-3);
     assert!((reports[1].lr - schedule.lr(1)).abs() < 1e-15);
     assert!(reports.iter().all(|r| r.grad_norm > 0.0));
@@ -538,7 +539,7 @@ fn trainer_writes_checkpoints_and_metrics_and_resumes() {
         .lines()
         .nth(1)
         .unwrap()
-        .ends_with(&format!(",{}", reports[0].grad_norm)));
+        .ends_with(&format!(",{},2", reports[0].grad_norm)));
 
     // The resumed run keeps the clipping and the schedule (a new plan of the same rates
     // and end keeps the old start).
