@@ -42,21 +42,22 @@ fn dataset() -> &'static Path {
     static DIR: OnceLock<(tempfile::TempDir, PathBuf)> = OnceLock::new();
     &DIR.get_or_init(|| {
         let tmp = tempfile::tempdir().unwrap();
-        let spec = tmp.path().join("spec.toml");
-        std::fs::write(&spec, SPEC).unwrap();
-        let data = tmp.path().join("data");
-        ok(&[
-            "dataset",
-            "generate",
-            s(&spec),
-            "--out",
-            s(&data),
-            "--jobs",
-            "2",
-        ]);
+        let data = generate_in(tmp.path(), SPEC, &["--jobs", "2"]);
         (tmp, data)
     })
     .1
+}
+
+/// Writes `spec` to `dir/spec.toml` and runs `garnet dataset generate` on it into
+/// `dir/data` with the `extra` flags; returns the data folder.
+fn generate_in(dir: &Path, spec: &str, extra: &[&str]) -> PathBuf {
+    let spec_path = dir.join("spec.toml");
+    std::fs::write(&spec_path, spec).unwrap();
+    let data = dir.join("data");
+    let mut args = vec!["dataset", "generate", s(&spec_path), "--out", s(&data)];
+    args.extend_from_slice(extra);
+    ok(&args);
+    data
 }
 
 #[test]
@@ -388,22 +389,10 @@ fn train_and_eval_leave_out_drapes_not_at_rest_or_overstretched() {
 #[test]
 fn best_starts_afresh_when_the_validation_split_grows() {
     let tmp = tempfile::tempdir().unwrap();
-    let spec = tmp.path().join("spec.toml");
     // One sample a shard: shards 0-1 train, 2-3 test, 4-5 validation.
-    std::fs::write(&spec, SPEC.replace("shard_size = 2", "shard_size = 1")).unwrap();
-    let data = tmp.path().join("data");
-    let generate = |shards: &str| {
-        ok(&[
-            "dataset",
-            "generate",
-            s(&spec),
-            "--out",
-            s(&data),
-            "--shard",
-            shards,
-        ])
-    };
-    generate("0-4");
+    let spec = SPEC.replace("shard_size = 2", "shard_size = 1");
+    let generate = |shards: &str| generate_in(tmp.path(), &spec, &["--shard", shards]);
+    let data = generate("0-4");
     let run = tmp.path().join("run");
     let log = ok(&train_args(&data, "naive", "1", &run, &[]));
     assert!(log.contains("(1 validation)"), "{log}");
