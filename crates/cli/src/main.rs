@@ -68,7 +68,7 @@ enum Cmd {
     Export(export_cmd::ExportArgs),
     /// Average the networks of several checkpoints of one run into one (weight averaging).
     Average(average_cmd::AverageArgs),
-    /// Add residual blocks that start as the identity to a trained network (train it on after).
+    /// Grow a trained network (wider layers, more residual blocks) draping as before (train it on after).
     Grow(grow_cmd::GrowArgs),
     /// The paper's errors (E_dist, E_norm) between two drapes of one garment mesh.
     Compare(compare_cmd::CompareArgs),

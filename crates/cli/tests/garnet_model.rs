@@ -664,8 +664,8 @@ fn average_writes_a_checkpoint_that_exports() {
     assert!(err.contains("--models"), "{err}");
 }
 
-/// `garnet grow`: the grown checkpoint evaluates as its parent, and `garnet train --resume`
-/// trains it on; Naive is refused.
+/// `garnet grow`: the grown and the widened checkpoints evaluate as their parent, and `garnet
+/// train --resume` trains the grown one on; narrowing and Naive's convolutions are refused.
 #[test]
 fn grow_keeps_the_drapes_and_trains_on() {
     let data = dataset();
@@ -705,6 +705,33 @@ fn grow_keeps_the_drapes_and_trains_on() {
         row.split('|').nth(4).unwrap().trim().to_string()
     };
     assert_eq!(e_dist(&parent), e_dist(&grown));
+    // Wider convolutions and fusion drape as before too (up to the rounding of longer sums).
+    let wide = tmp.path().join("wide.garnet");
+    let narrow = tmp.path().join("narrow.garnet");
+    let grow_wide = |conv: &'static str, out: &Path| {
+        let out = s(out).to_string();
+        let args = [
+            "grow",
+            "--model",
+            s(&parent),
+            "--conv-width",
+            conv,
+            "--fusion",
+        ];
+        let mut v = owned(&args);
+        v.extend(["160,64,32".to_string(), "--out".to_string(), out]);
+        v
+    };
+    let args = grow_wide("48", &wide);
+    let log = ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(
+        log.contains("convolutions 48 features wide, fusion widths [160, 64, 32]"),
+        "{log}"
+    );
+    assert_eq!(e_dist(&parent), e_dist(&wide));
+    let args = grow_wide("16", &narrow);
+    let err = fails(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(err.contains("can only be widened"), "{err}");
     let log = ok(&train_args(data, "global", "2", &run, &["--resume"]));
     assert!(
         log.contains("GarNet-global +2 blocks") && log.contains("epoch 2"),

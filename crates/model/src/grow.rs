@@ -1,7 +1,8 @@
 //! Growing a trained network: extra residual blocks of mesh convolutions appended to the
 //! garment stream ([`GarNetConfig::extra_blocks`]), each starting as the identity, so the
 //! grown network drapes exactly as its parent and training goes on from there with more
-//! depth, instead of starting a deeper network from scratch.
+//! depth, instead of starting a deeper network from scratch; and wider layers
+//! ([`crate::widen`]), likewise draping as before.
 
 use std::path::Path;
 
@@ -13,6 +14,7 @@ use crate::config::GarNetConfig;
 use crate::error::{ModelError, Result};
 use crate::garment_stream::ExtraBlock;
 use crate::garnet::GarNet;
+use crate::widen::widen_network;
 
 /// `model` (built from `config`) with `extra` more identity-initialised blocks on `device`,
 /// and its config. GarNet-Naive, without mesh convolutions, is refused.
@@ -50,19 +52,39 @@ pub fn grow_network(
     Ok((model, grown))
 }
 
-/// Reads the checkpoint `input`, adds `extra` blocks to its network and writes it to `out`
+/// How to grow a trained network: wider layers first ([`crate::widen`]), then more blocks.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct GrowPlan {
+    /// Residual blocks to append ([`grow_network`]).
+    pub extra_blocks: usize,
+    /// Features of the mesh convolutions, if wider than the network's.
+    pub conv_width: Option<usize>,
+    /// Hidden widths of the fusion network, if wider than the network's.
+    pub fusion: Option<Vec<usize>>,
+}
+
+/// Reads the checkpoint `input`, grows its network as `plan` says and writes it to `out`
 /// without optimiser state (a resumed run starts Adam afresh). Progress and the best
 /// validation figure carry over (the grown network drapes as its parent); `command` is
 /// recorded after the training command. Returns the grown network's parameter count.
-pub fn grow_checkpoint(input: &Path, out: &Path, extra: usize, command: &str) -> Result<usize> {
-    if extra == 0 {
+pub fn grow_checkpoint(input: &Path, out: &Path, plan: &GrowPlan, command: &str) -> Result<usize> {
+    if plan.extra_blocks == 0 && plan.conv_width.is_none() && plan.fusion.is_none() {
         return Err(ModelError::InvalidInput(
-            "growing needs at least one extra block".into(),
+            "growing needs extra blocks or wider layers".into(),
         ));
     }
     let ck = load_checkpoint(input)?;
     let device = Device::flex();
-    let (model, config) = grow_network(ck.model(&device)?, &ck.setup.config, extra, &device)?;
+    let mut config = ck.setup.config.clone();
+    let mut model = ck.model(&device)?;
+    if plan.conv_width.is_some() || plan.fusion.is_some() {
+        let conv_width = plan.conv_width.unwrap_or(config.conv_width);
+        let fusion = plan.fusion.clone().unwrap_or_else(|| config.fusion.clone());
+        (model, config) = widen_network(model, &config, conv_width, &fusion, &device)?;
+    }
+    if plan.extra_blocks > 0 {
+        (model, config) = grow_network(model, &config, plan.extra_blocks, &device)?;
+    }
     let mut setup = ck.setup;
     setup.config = config;
     let mut state = ck.state;

@@ -63,6 +63,7 @@ pub mod tensors;
 pub mod topology;
 pub mod train;
 pub mod trainer;
+pub mod widen;
 
 pub use alloc::tune_allocator;
 pub use average::{average_checkpoints, average_networks, AverageReport};
@@ -73,7 +74,7 @@ pub use drape::Draper;
 pub use error::{ModelError, Result};
 pub use frame::CanonicalFrame;
 pub use garnet::GarNet;
-pub use grow::{grow_checkpoint, grow_network};
+pub use grow::{grow_checkpoint, grow_network, GrowPlan};
 pub use init::LEAKY_SLOPE;
 pub use local::{BodySampling, LocalIndices};
 pub use loss::{garnet_loss, LossConfig, LossTerms};
@@ -82,6 +83,7 @@ pub use schedule::CosineSchedule;
 pub use topology::{GarmentTopology, TopologyTensors};
 pub use train::{adam, evaluate_batch, train_step, Evaluation, StepReport, PAPER_LEARNING_RATE};
 pub use trainer::{EpochReport, Trainer, Validation};
+pub use widen::widen_network;
 
 /// burn's optimiser type used for GarNet (Adam).
 pub use burn::optim::ModuleOptimizer as Optimizer;

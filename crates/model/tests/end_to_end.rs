@@ -879,7 +879,11 @@ fn grown_checkpoint_drapes_as_its_parent_then_trains_its_new_blocks() {
     let parent = dir.path().join("parent.garnet");
     trainer.save(&parent).unwrap();
     let grown = dir.path().join("grown.garnet");
-    let params = grow_checkpoint(&parent, &grown, 2, "garnet grow").unwrap();
+    let plan = GrowPlan {
+        extra_blocks: 2,
+        ..GrowPlan::default()
+    };
+    let params = grow_checkpoint(&parent, &grown, &plan, "garnet grow").unwrap();
     let ck = load_checkpoint(&grown).unwrap();
     assert_eq!(ck.setup.config.extra_blocks, 2);
     assert_eq!(ck.state.step, 2);
@@ -907,5 +911,68 @@ fn grown_checkpoint_drapes_as_its_parent_then_trains_its_new_blocks() {
     assert!(w.iter().any(|&v| v != 0.0));
     let trained = more.draper().unwrap().drape_batch(&pairs).unwrap();
     assert_ne!(bits(&trained), bits(&after));
-    assert!(grow_checkpoint(&parent, &grown, 0, "x").is_err());
+    assert!(grow_checkpoint(&parent, &grown, &GrowPlan::default(), "x").is_err());
+}
+
+/// A checkpoint widened by `grow_checkpoint` (wider convolutions and fusion, then an extra
+/// block) drapes as its parent up to the rounding of longer sums, and training reaches its
+/// new features: the weights from them into trained ones start at zero and leave it.
+#[test]
+fn widened_checkpoint_drapes_as_its_parent_then_trains_its_new_features() {
+    let device = Device::flex();
+    let dir = tempfile::tempdir().unwrap();
+    let s = setup(Variant::Local, 60);
+    let data = samples(&s, 3);
+    let mut trainer = Trainer::new(s, LossConfig::new(), 1e-3, &device).unwrap();
+    for _ in 0..2 {
+        trainer.step(&data[..2]).unwrap();
+    }
+    let parent = dir.path().join("parent.garnet");
+    trainer.save(&parent).unwrap();
+    let wide = dir.path().join("wide.garnet");
+    let plan = GrowPlan {
+        extra_blocks: 1,
+        conv_width: Some(24),
+        fusion: Some(vec![80, 48, 16]),
+    };
+    let params = grow_checkpoint(&parent, &wide, &plan, "garnet grow").unwrap();
+    let ck = load_checkpoint(&wide).unwrap();
+    let cfg = &ck.setup.config;
+    assert_eq!((cfg.conv_width, cfg.extra_blocks), (24, 1));
+    assert_eq!(cfg.fusion, vec![80, 48, 16]);
+    assert_eq!(ck.state.step, 2);
+    assert_eq!(ck.model(&device).unwrap().num_params(), params);
+
+    let pairs: Vec<(&[Vec3], &[Vec3])> =
+        data.iter().map(|d| (&d.body[..], &d.warped[..])).collect();
+    let drape = |p: &std::path::Path| {
+        let d = Draper::load(p, &device)
+            .unwrap()
+            .drape_batch(&pairs)
+            .unwrap();
+        d.into_iter().flatten().collect::<Vec<Vec3>>()
+    };
+    let (before, after) = (drape(&parent), drape(&wide));
+    let worst = before
+        .iter()
+        .zip(&after)
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0f32, f32::max);
+    assert!(worst < 1e-5, "widening moved a vertex {worst} m");
+
+    // The second fusion layer's rows from the new first-layer features, into its trained
+    // columns (the first 32), are zero, and training moves them.
+    let new_rows = |t: &Trainer| {
+        let w = model::tensors::read_f32(t.model().fusion.hidden[0].weight.val()).unwrap();
+        (64..80)
+            .flat_map(|r| (0..32).map(move |c| (r, c)))
+            .map(|(r, c)| w[r * 48 + c])
+            .collect::<Vec<f32>>()
+    };
+    let mut more = Trainer::resume(&wide, None, &device).unwrap();
+    assert!(new_rows(&more).iter().all(|&v| v == 0.0));
+    for _ in 0..2 {
+        more.step(&data[..2]).unwrap();
+    }
+    assert!(new_rows(&more).iter().any(|&v| v != 0.0));
 }
