@@ -863,6 +863,20 @@ fn averaged_checkpoint_holds_the_mean_network() {
     assert!(err.contains("not averageable"), "{err}");
 }
 
+/// A GarNet-Local checkpoint `dir/parent.garnet` after two training steps on the first two
+/// of three synthetic samples, and the samples.
+fn trained_parent(dir: &std::path::Path, device: &Device) -> (std::path::PathBuf, Vec<Sample>) {
+    let s = setup(Variant::Local, 60);
+    let data = samples(&s, 3);
+    let mut trainer = Trainer::new(s, LossConfig::new(), 1e-3, device).unwrap();
+    for _ in 0..2 {
+        trainer.step(&data[..2]).unwrap();
+    }
+    let parent = dir.join("parent.garnet");
+    trainer.save(&parent).unwrap();
+    (parent, data)
+}
+
 /// A checkpoint grown by `grow_checkpoint` drapes bit for bit as its parent, keeps its
 /// progress, and its new blocks learn: after training steps their head weights are no
 /// longer zero and the drapes differ.
@@ -870,14 +884,7 @@ fn averaged_checkpoint_holds_the_mean_network() {
 fn grown_checkpoint_drapes_as_its_parent_then_trains_its_new_blocks() {
     let device = Device::flex();
     let dir = tempfile::tempdir().unwrap();
-    let s = setup(Variant::Local, 60);
-    let data = samples(&s, 3);
-    let mut trainer = Trainer::new(s, LossConfig::new(), 1e-3, &device).unwrap();
-    for _ in 0..2 {
-        trainer.step(&data[..2]).unwrap();
-    }
-    let parent = dir.path().join("parent.garnet");
-    trainer.save(&parent).unwrap();
+    let (parent, data) = trained_parent(dir.path(), &device);
     let grown = dir.path().join("grown.garnet");
     let plan = GrowPlan {
         extra_blocks: 2,
@@ -921,14 +928,7 @@ fn grown_checkpoint_drapes_as_its_parent_then_trains_its_new_blocks() {
 fn widened_checkpoint_drapes_as_its_parent_then_trains_its_new_features() {
     let device = Device::flex();
     let dir = tempfile::tempdir().unwrap();
-    let s = setup(Variant::Local, 60);
-    let data = samples(&s, 3);
-    let mut trainer = Trainer::new(s, LossConfig::new(), 1e-3, &device).unwrap();
-    for _ in 0..2 {
-        trainer.step(&data[..2]).unwrap();
-    }
-    let parent = dir.path().join("parent.garnet");
-    trainer.save(&parent).unwrap();
+    let (parent, data) = trained_parent(dir.path(), &device);
     let wide = dir.path().join("wide.garnet");
     let plan = GrowPlan {
         extra_blocks: 1,
