@@ -1,0 +1,126 @@
+#!/usr/bin/env python3
+"""Where a network's drapes differ from the simulator's: analyses of `garnet eval
+--save-drapes DIR` output (DIR/MODEL/INDEX-{net,sim,dqs,body}.ply in metres and
+DIR/MODEL/samples.csv), read against the dataset's manifest. Needs numpy (and scipy for
+`scales`). Lengths are reported in cm.
+
+  drape_errors.py by-stat DRAPES DATASET   E_dist by quartile of the manifest's statistics
+  drape_errors.py shrink  DRAPES DATASET   how far the network moves the cloth from M
+  drape_errors.py scales  DRAPES           the error field's smooth part and what is left
+"""
+import csv
+import glob
+import json
+import sys
+
+import numpy as np
+
+
+def read_ply(path, faces=False):
+    """Vertices [N, 3] (and faces [F, 3] with faces=True) of a binary PLY written by garnet."""
+    data = open(path, 'rb').read()
+    head, _, body = data.partition(b'end_header\n')
+    lines = head.split(b'\n')
+    count = lambda name: int([l for l in lines if l.startswith(b'element ' + name)][0].split()[2])
+    n = count(b'vertex')
+    v = np.frombuffer(body[:n * 12], dtype='<f4').reshape(n, 3).astype(np.float64)
+    if not faces:
+        return v
+    rec = np.dtype([('count', 'u1'), ('index', '<i4', (3,))])
+    return v, np.frombuffer(body[n * 12:], dtype=rec, count=count(b'face'))['index']
+
+
+class Drapes:
+    """One model's saved drapes and, optionally, the dataset's manifest entries."""
+
+    def __init__(self, folder, dataset=None):
+        self.dir = glob.glob(folder.rstrip('/') + '/*/')[0]
+        self.rows = list(csv.DictReader(open(self.dir + 'samples.csv')))
+        self.samples = {}
+        if dataset:
+            manifest = json.load(open(dataset.rstrip('/') + '/manifest.json'))
+            self.samples = {s['index']: s for s in manifest['samples']}
+
+    def mesh(self, index, kind):
+        return read_ply(f'{self.dir}{index:06d}-{kind}.ply')
+
+    def each(self):
+        """(index, net, sim, dqs) of every drape."""
+        for r in self.rows:
+            k = int(r['index'])
+            yield k, self.mesh(k, 'net'), self.mesh(k, 'sim'), self.mesh(k, 'dqs')
+
+
+def mean_dist_cm(a, b):
+    return 100 * np.linalg.norm(a - b, axis=1).mean()
+
+
+def quartile_table(key, values, errors):
+    q = np.quantile(values, [0, .25, .5, .75, 1])
+    cells = [errors[(values >= lo) & (values <= hi)].mean() for lo, hi in zip(q[:-1], q[1:])]
+    print(f"{key:22s} " + ' '.join(f'{c:6.3f}' for c in cells) +
+          f"   corr {np.corrcoef(values, errors)[0, 1]:5.2f}")
+
+
+def by_stat(drapes):
+    k = [int(r['index']) for r in drapes.rows]
+    e = np.array([float(r['e_dist_cm']) for r in drapes.rows])
+    stat = lambda f: np.array([f(drapes.samples[i]) for i in k])
+    print('E_dist (cm) by quartile, lowest to highest')
+    quartile_table('slid_m', stat(lambda s: s['stats']['slid_m']), e)
+    quartile_table('DQS E_dist', np.array([float(r['dqs_e_dist_cm']) for r in drapes.rows]), e)
+    quartile_table('strain p99', stat(lambda s: s['stats']['strain_p99']), e)
+    quartile_table('bmi', stat(lambda s: s['bmi']), e)
+    quartile_table('stature', stat(lambda s: s['stature_m']), e)
+    rest = stat(lambda s: s['stats']['converged'])
+    print(f'came to rest: {rest.sum()} drapes, {e[rest].mean():.3f} cm; '
+          f'still moving: {(~rest).sum()} drapes, {e[~rest].mean():.3f} cm')
+
+
+def shrink(drapes):
+    res = []
+    for k, net, sim, dqs in drapes.each():
+        true, pred = sim - dqs, net - dqs
+        res.append((drapes.samples[k]['stats']['slid_m'], mean_dist_cm(sim, dqs),
+                    mean_dist_cm(net, dqs), (true * pred).sum() / (true * true).sum(),
+                    mean_dist_cm(net, sim)))
+    a = np.array(res)
+    q = np.quantile(a[:, 0], [0, .25, .5, .75, 1])
+    print('slid (m)       |G-M|  |net-M|  projection  E_dist (cm)')
+    for lo, hi in zip(q[:-1], q[1:]):
+        s = (a[:, 0] >= lo) & (a[:, 0] <= hi)
+        print(f'{lo:.3f}-{hi:.3f}  {a[s, 1].mean():5.2f}  {a[s, 2].mean():6.2f}  '
+              f'{a[s, 3].mean():10.2f}  {a[s, 4].mean():6.3f}')
+    for scale in (0.95, 1.0, 1.03, 1.06, 1.1):
+        e = [mean_dist_cm(dqs + scale * (net - dqs), sim) for _, net, sim, dqs in drapes.each()]
+        print(f'displacement scaled by {scale:.2f}: E_dist {np.mean(e):.4f} cm')
+
+
+def scales(drapes):
+    import scipy.sparse as sp
+    _, faces = read_ply(drapes.dir + f"{int(drapes.rows[0]['index']):06d}-sim.ply", True)
+    n = faces.max() + 1
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    edges = np.unique(np.concatenate([edges, edges[:, ::-1]]), axis=0)
+    ring = sp.csr_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n))
+    ring = sp.diags(1 / np.asarray(ring.sum(1)).ravel()) @ ring
+    marks = (5, 20, 80, 320)
+    parts = {m: [] for m in marks}
+    for _, net, sim, _ in drapes.each():
+        err = net - sim
+        smooth, done = err.copy(), 0
+        for m in marks:
+            while done < m:
+                smooth, done = 0.5 * smooth + 0.5 * (ring @ smooth), done + 1
+            parts[m].append((mean_dist_cm(smooth, 0), mean_dist_cm(err - smooth, 0)))
+    for m in marks:
+        a = np.array(parts[m])
+        print(f'{m:3d} iterations: smoothed part {a[:, 0].mean():.2f} cm, '
+              f'remainder {a[:, 1].mean():.2f} cm')
+
+
+if __name__ == '__main__':
+    if len(sys.argv) < 3 or sys.argv[1] not in ('by-stat', 'shrink', 'scales'):
+        sys.exit(__doc__)
+    command = {'by-stat': by_stat, 'shrink': shrink, 'scales': scales}[sys.argv[1]]
+    command(Drapes(sys.argv[2], sys.argv[3] if len(sys.argv) > 3 else None))
