@@ -130,6 +130,7 @@ pub fn generate(
         drape_options: spec.spec.simulator.drape_options().expect("validated"),
         templates: TemplateStore::new(out, plan.garments.len() + 2 * jobs + 2),
         bodies: KeyedCache::new(2 * jobs + 4),
+        morphs: KeyedCache::new(2 * jobs + 2),
     };
     for (g, garment) in plan.garments.iter().enumerate() {
         if garment.per_body() {

@@ -7,7 +7,8 @@ use std::time::Instant;
 use body::shape_sampler::stature_and_bmi;
 use body::{BodyModel, ShapedBody, Skinning};
 use garment::warp::{warp, warp_fitted, SurfaceAnchors};
-use sim::drape::{drape, DrapeOptions};
+use sim::drape::{drape_morphed, DrapeOptions};
+use sim::morph::{morph, Morphed};
 
 use crate::cache::KeyedCache;
 use crate::error::{DatasetError, Result};
@@ -39,6 +40,10 @@ pub struct Maker<'a> {
     pub templates: TemplateStore,
     /// Recently shaped bodies.
     pub bodies: KeyedCache<u32, std::result::Result<BodyEntry, String>>,
+    /// The cloth after the shape morph, by garment and body: the part of a drape that
+    /// every pose of one body shares (the drapes are the same to the bit; only the morph
+    /// is not simulated again). An error is the drape's, as a failure reason.
+    pub morphs: KeyedCache<(usize, u32), std::result::Result<Arc<Morphed>, String>>,
 }
 
 /// What became of a sample.
@@ -107,16 +112,31 @@ impl Maker<'_> {
             Err(m) => return fail(m, 0.0),
         };
         let opts = &self.drape_options;
-        let draped = match drape(
-            &template,
-            &self.template_body,
-            target,
-            &pose,
-            opts,
-            &mut |_, _, _| {},
-        ) {
+        let morphed = self.morphs.get_or_init(&(desc.garment, desc.body), || {
+            morph(
+                &template,
+                &self.template_body,
+                target,
+                opts,
+                &mut |_, _, _| {},
+            )
+            .map(Arc::new)
+            .map_err(|e| format!("drape: {e}"))
+        });
+        let drape_start = Instant::now();
+        let draped = match morphed.and_then(|m| {
+            drape_morphed(
+                (*m).clone(),
+                &template,
+                target,
+                &pose,
+                opts,
+                &mut |_, _, _| {},
+            )
+            .map_err(|e| format!("drape: {e}"))
+        }) {
             Ok(d) => d,
-            Err(e) => return fail(format!("drape: {e}"), start.elapsed().as_secs_f64()),
+            Err(m) => return fail(m, drape_start.elapsed().as_secs_f64()),
         };
         // The drape may have corrected the pose (limb clearance): M, G, the body and the
         // stored pose parameters all use the pose the body actually took.

@@ -43,8 +43,9 @@ pub struct StepInfo {
 }
 
 /// A cloth simulation: a triangle mesh of cloth with per-vertex state (positions,
-/// velocities, pinned flags, contact memory) and its prefactored system.
-#[derive(Debug)]
+/// velocities, pinned flags, contact memory) and its prefactored system. A clone carries
+/// on exactly as the original would.
+#[derive(Clone, Debug)]
 pub struct ClothSim {
     pub(crate) params: ClothParams,
     pub(crate) faces: Vec<[u32; 3]>,

@@ -12,14 +12,14 @@ use std::time::Instant;
 
 use body::clearance::{clear_limbs, ClearanceOptions};
 use body::{Pose, ShapedBody, Skinning};
-use garment::warp::SurfaceAnchors;
 use garment::GarmentTemplate;
 use geom::TriMesh;
 use glam::{Quat, Vec3};
 
+use crate::morph::{morph, Morphed};
 use crate::stats::{percentile, DrapeStats, SKIN_TOUCH_M};
 use crate::waistband::Waistband;
-use crate::{BodyCollider, ClothParams, ClothSim, SimError};
+use crate::{ClothParams, SimError};
 
 /// Settings of a drape.
 #[derive(Clone, Debug)]
@@ -39,7 +39,7 @@ pub struct DrapeOptions {
     pub max_settle_steps: u32,
     /// While settling, every this many steps (from the first), cloth caught inside the
     /// body where its closest surface leads no way out (between overlapping body parts) is
-    /// walked out ([`ClothSim::walk_out_of`]), so the cloth relaxes around it instead of
+    /// walked out ([`crate::ClothSim::walk_out_of`]), so the cloth relaxes around it instead of
     /// jittering against the per-step projection; 0: only by the exact pass after the
     /// last step.
     pub walk_out_every: u32,
@@ -125,7 +125,7 @@ fn split_yaw(world: Quat) -> (Quat, Quat) {
 /// Drapes `template` (fitted on `template_body`, its rest shape) onto `target` in `pose`.
 /// `on_frame(step, garment, body)` sees every step (for recording the animation).
 /// Errors if the simulation diverges (NaN, exploding speed) or leaves cloth inside the
-/// body; the error says which and when.
+/// body; the error says which and when. The same as [`morph`] then [`drape_morphed`].
 pub fn drape(
     template: &GarmentTemplate,
     template_body: &ShapedBody,
@@ -135,13 +135,15 @@ pub fn drape(
     on_frame: &mut FrameObserver<'_>,
 ) -> Result<Drape, SimError> {
     let start = Instant::now();
-    if template_body.mesh.vertices.len() != target.mesh.vertices.len()
-        || template.mesh.vertices.is_empty()
-    {
-        return Err(SimError::InvalidInput(
-            "the target body does not share the template body's mesh".into(),
-        ));
-    }
+    check_pose(target, pose)?;
+    let morphed = morph(template, template_body, target, opts, on_frame)?;
+    let mut drape = drape_morphed(morphed, template, target, pose, opts, on_frame)?;
+    drape.stats.wall_time_s = start.elapsed().as_secs_f64();
+    Ok(drape)
+}
+
+/// Errors unless `pose` fits `target`'s rig and is finite.
+fn check_pose(target: &ShapedBody, pose: &Pose) -> Result<(), SimError> {
     if pose.rotations.len() != target.rig.len()
         || !pose.root_translation.is_finite()
         || pose.rotations.iter().any(|q| !q.is_finite())
@@ -150,6 +152,22 @@ pub fn drape(
             "the pose does not fit the body's rig or holds NaN".into(),
         ));
     }
+    Ok(())
+}
+
+/// Finishes a drape from the cloth `m` that [`morph`] made for `template` on `target`:
+/// the body moves into `pose`, the cloth settles, and the result is checked and measured.
+/// `on_frame` sees the steps after the morph's. `stats.wall_time_s` counts this part only.
+pub fn drape_morphed(
+    mut m: Morphed,
+    template: &GarmentTemplate,
+    target: &ShapedBody,
+    pose: &Pose,
+    opts: &DrapeOptions,
+    on_frame: &mut FrameObserver<'_>,
+) -> Result<Drape, SimError> {
+    let start = Instant::now();
+    check_pose(target, pose)?;
     let (pose, limb_turn_deg) = match &opts.clearance {
         Some(c) => {
             let (p, report) =
@@ -160,60 +178,6 @@ pub fn drape(
     };
     let (yaw, mut calm) = remove_root_yaw(target, &pose);
     calm.rotations.iter_mut().for_each(|q| *q = q.normalize());
-    let anchors = SurfaceAnchors::new(&template.mesh, &template_body.mesh)
-        .map_err(|e| SimError::InvalidInput(e.to_string()))?;
-    let (mut rest, rest_body) = if opts.grade {
-        (anchors.place(&target.mesh), &target.mesh)
-    } else {
-        (template.mesh.vertices.clone(), &template_body.mesh)
-    };
-    let stretch_scale = match &opts.waistband {
-        Some(band) => band.apply(template, &mut rest, rest_body)?,
-        None => None,
-    }
-    .unwrap_or_else(|| vec![1.0; rest.len()]);
-    let rest = TriMesh {
-        vertices: rest,
-        faces: template.mesh.faces.clone(),
-    };
-    let mut sim = ClothSim::with_stretch_scale(&rest, &opts.cloth, &stretch_scale)?;
-    sim.set_positions(&template.mesh.vertices)?;
-    let mut collider = BodyCollider::new(&template_body.mesh, opts.cloth.thickness)?;
-    let mass = cloth_mass(&template.mesh, opts.cloth.density);
-    let rms_speed = |sim: &ClothSim| (2.0 * sim.kinetic_energy() / mass).sqrt();
-    let mut step = 0u32;
-    let mut advance = |sim: &mut ClothSim,
-                       collider: &mut BodyCollider,
-                       body: &[Vec3],
-                       step: &mut u32|
-     -> Result<(), SimError> {
-        collider.move_to(body)?;
-        sim.step(Some(collider))?;
-        let speed = rms_speed(sim);
-        if !speed.is_finite() || speed > opts.explode_speed {
-            return Err(SimError::Diverged(format!(
-                "cloth speed {speed:.1} m/s at step {step}"
-            )));
-        }
-        on_frame(*step, sim.positions(), body);
-        *step += 1;
-        Ok(())
-    };
-    // Shape: the body's rest mesh morphs linearly from the template shape to the target's.
-    let morphed = |t: f32| -> Result<Vec<Vec3>, SimError> {
-        Ok(template_body
-            .mesh
-            .vertices
-            .iter()
-            .zip(&target.mesh.vertices)
-            .map(|(a, b)| a.lerp(*b, t))
-            .collect())
-    };
-    let morph_steps = phase_steps(opts.morph_steps, opts.body_step, 1, &morphed)?;
-    for k in 1..=morph_steps {
-        let body = morphed(k as f32 / morph_steps as f32)?;
-        advance(&mut sim, &mut collider, &body, &mut step)?;
-    }
     // Pose: every joint slerps from rest to the target (root yaw left out).
     let rest = Pose::identity(target.rig.len());
     let posed = |t: f32| -> Result<Vec<Vec3>, SimError> {
@@ -226,33 +190,34 @@ pub fn drape(
     let mut body = target.mesh.vertices.clone();
     for k in 1..=pose_steps {
         body = posed(k as f32 / pose_steps as f32)?;
-        advance(&mut sim, &mut collider, &body, &mut step)?;
+        m.advance(&body, opts, on_frame)?;
     }
-    let animation_steps = step;
+    let animation_steps = m.steps;
     let mut converged = false;
     let mut walked = 0;
-    while step - animation_steps < opts.max_settle_steps {
-        let settled = step - animation_steps;
+    while m.steps - animation_steps < opts.max_settle_steps {
+        let settled = m.steps - animation_steps;
         if opts.walk_out_every > 0 && settled % opts.walk_out_every == 0 {
-            walked += sim.walk_out_of(&collider);
+            walked += m.sim.walk_out_of(&m.collider);
         }
-        advance(&mut sim, &mut collider, &body, &mut step)?;
-        if rms_speed(&sim) < opts.rest_speed {
+        m.advance(&body, opts, on_frame)?;
+        if m.rms_speed() < opts.rest_speed {
             converged = true;
             break;
         }
     }
-    walked += sim.project_out_of(&collider).1;
+    let (sim, collider) = (&mut m.sim, &m.collider);
+    walked += sim.project_out_of(collider).1;
     let mut stats = DrapeStats {
         walked_out: walked as u32,
         animation_steps,
-        settle_steps: step - animation_steps,
+        settle_steps: m.steps - animation_steps,
         final_kinetic_energy: sim.kinetic_energy(),
         converged,
         limb_turn_deg,
         slid_m: mean_distance(
             sim.positions(),
-            &anchors.place(&TriMesh {
+            &m.anchors.place(&TriMesh {
                 vertices: body.clone(),
                 faces: target.mesh.faces.clone(),
             }),
@@ -302,7 +267,7 @@ const POSE_PATH_SAMPLES: u32 = 8;
 /// fewest that keep every vertex's travel per step, measured along the path through
 /// `samples` equal chords, at most `step_len` metres; at least 1 and at most `max_steps`
 /// (which a non-positive or non-finite `step_len` always gives).
-fn phase_steps(
+pub(crate) fn phase_steps(
     max_steps: u32,
     step_len: f32,
     samples: u32,
@@ -339,14 +304,6 @@ fn remove_root_yaw(target: &ShapedBody, pose: &Pose) -> (Quat, Pose) {
 fn mean_distance(a: &[Vec3], b: &[Vec3]) -> f32 {
     let sum: f64 = a.iter().zip(b).map(|(p, q)| p.distance(*q) as f64).sum();
     (sum / a.len().max(1) as f64) as f32
-}
-
-/// Total mass of a cloth mesh of `density` kg/m^2.
-fn cloth_mass(mesh: &TriMesh, density: f32) -> f32 {
-    geom::normals::face_areas(&mesh.vertices, &mesh.faces)
-        .iter()
-        .sum::<f32>()
-        * density
 }
 
 #[cfg(test)]

@@ -23,6 +23,7 @@ pub mod collide;
 pub mod constraints;
 pub mod drape;
 pub mod error;
+pub mod morph;
 pub mod params;
 pub mod pd;
 pub mod reference;

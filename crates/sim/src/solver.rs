@@ -20,6 +20,7 @@ use crate::error::{Result, SimError};
 
 /// A symmetric `[n, n]` sparsity pattern (lower triangle, CSC with sorted rows) with its
 /// symbolic Cholesky factorisation and, once [`SpdSolver::factor`] succeeded, a numeric one.
+#[derive(Clone)]
 pub struct SpdSolver {
     n: usize,
     col_ptr: Vec<usize>,

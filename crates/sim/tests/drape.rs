@@ -5,7 +5,9 @@ use body::{BodyModel, Phenotype, Pose, ShapedBody};
 use garment::{build_template, CutParams, GarmentKind, GarmentTemplate};
 use geom::bvh::Bvh;
 use glam::{Quat, Vec3};
-use sim::drape::{drape, DrapeOptions};
+use sim::drape::{drape, drape_morphed, DrapeOptions};
+use sim::morph::morph;
+use sim::stats::DrapeStats;
 use sim::waistband::Waistband;
 
 #[test]
@@ -271,4 +273,68 @@ fn the_waistband_holds_jeans_up_on_a_heavy_body_bent_forward() {
     );
     assert!(with.elastic_strain_p99 > 0.05 && without.elastic_strain_p99 == 0.0);
     assert!(with.strain_p99 < 0.02, "{}", with.summary());
+}
+
+/// The dataset drapes every pose of a body from one morph: a clone of [`morph`]'s cloth
+/// finished by [`drape_morphed`] must be the drape [`drape`] makes, to the bit.
+#[test]
+fn one_morph_serves_every_pose_to_the_bit() {
+    let kind = GarmentKind::Tshirt;
+    let (template, template_body, target) = on_a_heavy_body(&kind, CutParams::default_for(&kind));
+    let rig = &target.rig;
+    let mut world = vec![Quat::IDENTITY; rig.len()];
+    let arm = rig.index("LeftArm").unwrap();
+    rig.swing_limb(&mut world, arm, Vec3::new(-1.0, -0.3, 0.2));
+    let poses = [
+        Pose::from_world_rotations(rig, &world, Vec3::ZERO),
+        Pose::identity(rig.len()),
+    ];
+    let opts = DrapeOptions {
+        max_settle_steps: 40,
+        ..DrapeOptions::default()
+    };
+    let mut morph_frames = 0;
+    let morphed = morph(&template, &template_body, &target, &opts, &mut |_, _, _| {
+        morph_frames += 1
+    })
+    .unwrap();
+    assert!(morph_frames > 1, "the heavy body is a real morph");
+    for pose in &poses {
+        let mut frames = 0;
+        let whole = drape(
+            &template,
+            &template_body,
+            &target,
+            pose,
+            &opts,
+            &mut |_, _, _| frames += 1,
+        )
+        .unwrap();
+        let mut first = None;
+        let split = drape_morphed(
+            morphed.clone(),
+            &template,
+            &target,
+            pose,
+            &opts,
+            &mut |s, _, _| {
+                first.get_or_insert(s);
+            },
+        )
+        .unwrap();
+        assert_eq!(split.garment.vertices, whole.garment.vertices);
+        assert_eq!(split.body.vertices, whole.body.vertices);
+        assert_eq!(split.vertex_strain, whole.vertex_strain);
+        let no_time = |d: &sim::drape::Drape| DrapeStats {
+            wall_time_s: 0.0,
+            ..d.stats.clone()
+        };
+        assert_eq!(no_time(&split), no_time(&whole));
+        // The steps after the morph are numbered on from it.
+        assert_eq!(first, Some(morph_frames));
+        assert_eq!(
+            frames,
+            (whole.stats.animation_steps + whole.stats.settle_steps) as usize
+        );
+    }
 }
