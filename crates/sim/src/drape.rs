@@ -168,6 +168,7 @@ pub fn drape_morphed(
 ) -> Result<Drape, SimError> {
     let start = Instant::now();
     check_pose(target, pose)?;
+    m.check_fits(template, target)?;
     let (pose, limb_turn_deg) = match &opts.clearance {
         Some(c) => {
             let (p, report) =

@@ -27,6 +27,9 @@ pub struct Morphed {
     pub(crate) steps: u32,
     /// Total mass of the cloth, kg.
     pub(crate) mass: f32,
+    /// Vertices of the body it was morphed onto (a check that a drape finishes it on that
+    /// body's mesh).
+    pub(crate) body_vertices: usize,
 }
 
 /// Grades `template` (fitted on `template_body`, its rest shape) to `target` and carries it
@@ -71,6 +74,7 @@ pub fn morph(
         anchors,
         steps: 0,
         mass: cloth_mass(&template.mesh, opts.cloth.density),
+        body_vertices: target.mesh.vertices.len(),
     };
     // The body's rest mesh morphs linearly from the template shape to the target's.
     let morphed = |t: f32| -> Result<Vec<Vec3>, SimError> {
@@ -91,6 +95,26 @@ pub fn morph(
 }
 
 impl Morphed {
+    /// Errors unless this cloth was morphed from `template` onto a body of `target`'s mesh.
+    pub(crate) fn check_fits(
+        &self,
+        template: &GarmentTemplate,
+        target: &ShapedBody,
+    ) -> Result<(), SimError> {
+        if self.sim.positions().len() != template.mesh.vertices.len()
+            || self.body_vertices != target.mesh.vertices.len()
+        {
+            return Err(SimError::InvalidInput(format!(
+                "the morphed cloth ({} vertices on a body of {}) is not of this garment ({} vertices) and body ({})",
+                self.sim.positions().len(),
+                self.body_vertices,
+                template.mesh.vertices.len(),
+                target.mesh.vertices.len()
+            )));
+        }
+        Ok(())
+    }
+
     /// Root-mean-square speed of the cloth, m/s.
     pub(crate) fn rms_speed(&self) -> f32 {
         (2.0 * self.sim.kinetic_energy() / self.mass).sqrt()

@@ -338,3 +338,18 @@ fn one_morph_serves_every_pose_to_the_bit() {
         );
     }
 }
+
+/// A morphed cloth finished on another garment is refused, not simulated.
+#[test]
+fn a_morph_of_another_garment_is_refused() {
+    let kind = GarmentKind::Tshirt;
+    let (template, template_body, target) = on_a_heavy_body(&kind, CutParams::default_for(&kind));
+    let opts = DrapeOptions::default();
+    let morphed = morph(&template, &template_body, &target, &opts, &mut |_, _, _| {}).unwrap();
+    let model = BodyModel::load().expect("body assets");
+    let jeans = GarmentKind::Jeans;
+    let other = build_template(&model, &jeans, &CutParams::default_for(&jeans), 0.03).unwrap();
+    let pose = Pose::identity(target.rig.len());
+    let err = drape_morphed(morphed, &other, &target, &pose, &opts, &mut |_, _, _| {}).unwrap_err();
+    assert!(err.to_string().contains("not of this garment"), "{err}");
+}
