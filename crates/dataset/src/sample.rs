@@ -123,7 +123,6 @@ impl Maker<'_> {
             .map(Arc::new)
             .map_err(|e| format!("drape: {e}"))
         });
-        let drape_start = Instant::now();
         let draped = match morphed.and_then(|m| {
             drape_morphed(
                 (*m).clone(),
@@ -136,7 +135,7 @@ impl Maker<'_> {
             .map_err(|e| format!("drape: {e}"))
         }) {
             Ok(d) => d,
-            Err(m) => return fail(m, drape_start.elapsed().as_secs_f64()),
+            Err(m) => return fail(m, start.elapsed().as_secs_f64()),
         };
         // The drape may have corrected the pose (limb clearance): M, G, the body and the
         // stored pose parameters all use the pose the body actually took.

@@ -134,12 +134,9 @@ pub fn drape(
     opts: &DrapeOptions,
     on_frame: &mut FrameObserver<'_>,
 ) -> Result<Drape, SimError> {
-    let start = Instant::now();
     check_pose(target, pose)?;
     let morphed = morph(template, template_body, target, opts, on_frame)?;
-    let mut drape = drape_morphed(morphed, template, target, pose, opts, on_frame)?;
-    drape.stats.wall_time_s = start.elapsed().as_secs_f64();
-    Ok(drape)
+    drape_morphed(morphed, template, target, pose, opts, on_frame)
 }
 
 /// Errors unless `pose` fits `target`'s rig and is finite.
@@ -157,7 +154,8 @@ fn check_pose(target: &ShapedBody, pose: &Pose) -> Result<(), SimError> {
 
 /// Finishes a drape from the cloth `m` that [`morph`] made for `template` on `target`:
 /// the body moves into `pose`, the cloth settles, and the result is checked and measured.
-/// `on_frame` sees the steps after the morph's. `stats.wall_time_s` counts this part only.
+/// `on_frame` sees the steps after the morph's. `stats.wall_time_s` is the morph's wall time
+/// plus this part's: what the drape would take from scratch, however many share the morph.
 pub fn drape_morphed(
     mut m: Morphed,
     template: &GarmentTemplate,
@@ -244,7 +242,7 @@ pub fn drape_morphed(
     // Turn the result by the root's yaw about the vertical through the root.
     let centre = target.rig.bones[0].head + pose.root_translation;
     let turn = |p: &Vec3| yaw * (*p - centre) + centre;
-    stats.wall_time_s = start.elapsed().as_secs_f64();
+    stats.wall_time_s = m.wall_time_s + start.elapsed().as_secs_f64();
     Ok(Drape {
         garment: TriMesh {
             vertices: sim.positions().iter().map(turn).collect(),

@@ -27,6 +27,9 @@ pub struct Morphed {
     pub(crate) steps: u32,
     /// Total mass of the cloth, kg.
     pub(crate) mass: f32,
+    /// Wall time of making it (set-up and morph), seconds: counted into the wall time of
+    /// every drape finished from it, which is thus what a drape from scratch takes.
+    pub(crate) wall_time_s: f64,
     /// Vertices of the body it was morphed onto (a check that a drape finishes it on that
     /// body's mesh).
     pub(crate) body_vertices: usize,
@@ -43,6 +46,7 @@ pub fn morph(
     opts: &DrapeOptions,
     on_frame: &mut FrameObserver<'_>,
 ) -> Result<Morphed, SimError> {
+    let start = std::time::Instant::now();
     if template_body.mesh.vertices.len() != target.mesh.vertices.len()
         || template.mesh.vertices.is_empty()
     {
@@ -74,6 +78,7 @@ pub fn morph(
         anchors,
         steps: 0,
         mass: cloth_mass(&template.mesh, opts.cloth.density),
+        wall_time_s: 0.0,
         body_vertices: target.mesh.vertices.len(),
     };
     // The body's rest mesh morphs linearly from the template shape to the target's.
@@ -91,10 +96,16 @@ pub fn morph(
         let body = morphed(k as f32 / morph_steps as f32)?;
         m.advance(&body, opts, on_frame)?;
     }
+    m.wall_time_s = start.elapsed().as_secs_f64();
     Ok(m)
 }
 
 impl Morphed {
+    /// Wall time of making it (set-up and morph), seconds.
+    pub fn wall_time_s(&self) -> f64 {
+        self.wall_time_s
+    }
+
     /// Errors unless this cloth was morphed from `template` onto a body of `target`'s mesh.
     pub(crate) fn check_fits(
         &self,

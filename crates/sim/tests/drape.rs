@@ -330,6 +330,9 @@ fn one_morph_serves_every_pose_to_the_bit() {
             ..d.stats.clone()
         };
         assert_eq!(no_time(&split), no_time(&whole));
+        // Regression: the dataset's simulator timings (eval's Table 2) read this; a drape
+        // finished from a shared morph still counts the morph.
+        assert!(split.stats.wall_time_s > morphed.wall_time_s());
         // The steps after the morph are numbered on from it.
         assert_eq!(first, Some(morph_frames));
         assert_eq!(
