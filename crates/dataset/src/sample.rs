@@ -42,7 +42,7 @@ pub struct Maker<'a> {
     pub bodies: KeyedCache<u32, std::result::Result<BodyEntry, String>>,
     /// The cloth after the shape morph, by garment and body: the part of a drape that
     /// every pose of one body shares (the drapes are the same to the bit; only the morph
-    /// is not simulated again). An error is the drape's, as a failure reason.
+    /// is not simulated again). A failed morph is kept as its message.
     pub morphs: KeyedCache<(usize, u32), std::result::Result<Arc<Morphed>, String>>,
 }
 
@@ -121,7 +121,7 @@ impl Maker<'_> {
                 &mut |_, _, _| {},
             )
             .map(Arc::new)
-            .map_err(|e| format!("drape: {e}"))
+            .map_err(|e| e.to_string())
         });
         let draped = match morphed.and_then(|m| {
             drape_morphed(
@@ -132,10 +132,10 @@ impl Maker<'_> {
                 opts,
                 &mut |_, _, _| {},
             )
-            .map_err(|e| format!("drape: {e}"))
+            .map_err(|e| e.to_string())
         }) {
             Ok(d) => d,
-            Err(m) => return fail(m, start.elapsed().as_secs_f64()),
+            Err(e) => return fail(format!("drape: {e}"), start.elapsed().as_secs_f64()),
         };
         // The drape may have corrected the pose (limb clearance): M, G, the body and the
         // stored pose parameters all use the pose the body actually took.

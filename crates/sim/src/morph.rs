@@ -30,9 +30,6 @@ pub struct Morphed {
     /// Wall time of making it (set-up and morph), seconds: counted into the wall time of
     /// every drape finished from it, which is thus what a drape from scratch takes.
     pub(crate) wall_time_s: f64,
-    /// Vertices of the body it was morphed onto (a check that a drape finishes it on that
-    /// body's mesh).
-    pub(crate) body_vertices: usize,
 }
 
 /// Grades `template` (fitted on `template_body`, its rest shape) to `target` and carries it
@@ -79,7 +76,6 @@ pub fn morph(
         steps: 0,
         mass: cloth_mass(&template.mesh, opts.cloth.density),
         wall_time_s: 0.0,
-        body_vertices: target.mesh.vertices.len(),
     };
     // The body's rest mesh morphs linearly from the template shape to the target's.
     let morphed = |t: f32| -> Result<Vec<Vec3>, SimError> {
@@ -113,12 +109,12 @@ impl Morphed {
         target: &ShapedBody,
     ) -> Result<(), SimError> {
         if self.sim.positions().len() != template.mesh.vertices.len()
-            || self.body_vertices != target.mesh.vertices.len()
+            || self.collider.vertices().len() != target.mesh.vertices.len()
         {
             return Err(SimError::InvalidInput(format!(
                 "the morphed cloth ({} vertices on a body of {}) is not of this garment ({} vertices) and body ({})",
                 self.sim.positions().len(),
-                self.body_vertices,
+                self.collider.vertices().len(),
                 template.mesh.vertices.len(),
                 target.mesh.vertices.len()
             )));
