@@ -7,10 +7,13 @@ DIR/MODEL/samples.csv), read against the dataset's manifest. Needs numpy (and sc
   drape_errors.py by-stat DRAPES DATASET   E_dist by quartile of the manifest's statistics
   drape_errors.py shrink  DRAPES DATASET   how far the network moves the cloth from M
   drape_errors.py scales  DRAPES           the error field's smooth part and what is left
+  drape_errors.py regions DRAPES TEMPLATE  E_dist by region of the garment (each vertex's
+                                           dominant skinning bone in TEMPLATE, a .garment file)
 """
 import csv
 import glob
 import json
+import struct
 import sys
 
 import numpy as np
@@ -119,8 +122,40 @@ def scales(drapes):
               f'remainder {a[:, 1].mean():.2f} cm')
 
 
+def dominant_bones(template):
+    """Name of the bone with the largest skinning weight, per vertex of a `.garment` file
+    (safetensors: `weights.offsets` [N+1], `weights.bones` and `weights.values` per entry)."""
+    data = open(template, 'rb').read()
+    size = struct.unpack('<Q', data[:8])[0]
+    head = json.loads(data[8:8 + size])
+
+    def tensor(name, dtype):
+        start, end = head[name]['data_offsets']
+        return np.frombuffer(data[8 + size + start:8 + size + end], dtype=dtype)
+
+    names = [b['name'] for b in json.loads(head['__metadata__']['bones'])]
+    offsets, bones = tensor('weights.offsets', '<u4'), tensor('weights.bones', '<u2')
+    values = tensor('weights.values', '<f4')
+    return [names[bones[a:b][np.argmax(values[a:b])]] for a, b in zip(offsets[:-1], offsets[1:])]
+
+
+def regions(drapes, template):
+    limb = lambda b: any(part in b for part in ('Shoulder', 'Arm', 'Hand'))
+    region = np.array([('left arm' if b.startswith('L') else 'right arm') if limb(b) else b
+                       for b in dominant_bones(template)])
+    err = np.array([100 * np.linalg.norm(net - sim, axis=1) for _, net, sim, _ in drapes.each()])
+    print(f'{len(err)} drapes, E_dist {err.mean():.3f} cm')
+    for name in sorted(set(region), key=lambda r: -(region == r).sum()):
+        m = region == name
+        print(f'{name:12s} {m.sum():5d} vertices  E_dist {err[:, m].mean():.3f} cm  '
+              f'share of the error {100 * err[:, m].sum() / err.sum():4.1f}%')
+
+
 if __name__ == '__main__':
-    if len(sys.argv) < 3 or sys.argv[1] not in ('by-stat', 'shrink', 'scales'):
+    commands = {'by-stat': by_stat, 'shrink': shrink, 'scales': scales}
+    if len(sys.argv) == 4 and sys.argv[1] == 'regions':
+        regions(Drapes(sys.argv[2]), sys.argv[3])
+    elif len(sys.argv) >= 3 and sys.argv[1] in commands:
+        commands[sys.argv[1]](Drapes(sys.argv[2], sys.argv[3] if len(sys.argv) > 3 else None))
+    else:
         sys.exit(__doc__)
-    command = {'by-stat': by_stat, 'shrink': shrink, 'scales': scales}[sys.argv[1]]
-    command(Drapes(sys.argv[2], sys.argv[3] if len(sys.argv) > 3 else None))
