@@ -124,7 +124,9 @@ def scales(drapes):
 
 def dominant_bones(template):
     """Name of the bone with the largest skinning weight, per vertex of a `.garment` file
-    (safetensors: `weights.offsets` [N+1], `weights.bones` and `weights.values` per entry)."""
+    (safetensors: `weights.offsets` [N+1], `weights.bones` and `weights.values` per entry).
+    The header is read by hand (8-byte length, JSON) so that the script needs numpy alone,
+    not the `safetensors` package, for three small arrays."""
     data = open(template, 'rb').read()
     size = struct.unpack('<Q', data[:8])[0]
     head = json.loads(data[8:8 + size])
