@@ -66,6 +66,14 @@ pub struct GenerateArgs {
     /// inclusive ranges, e.g. 0-9,12; merge the folders after.
     #[arg(long, value_name = "i/n|a-b,c")]
     pub shard: Option<String>,
+    /// Of those, make only the shards that hold a sample of these splits (comma-separated,
+    /// e.g. test): the drapes an evaluation needs, without the rest of the dataset.
+    #[arg(long, value_name = "NAME,...", value_delimiter = ',')]
+    pub split: Vec<String>,
+    /// Of those, make only the shards that hold a sample of these garments (comma-separated
+    /// names, e.g. tshirt).
+    #[arg(long, value_name = "NAME,...", value_delimiter = ',')]
+    pub garment: Vec<String>,
     /// Take the samples an earlier dataset of a smaller spec already made (same seed,
     /// garments, poses and simulator; only the body count, poses per body, splits, shard
     /// size and output.compact may differ) instead of simulating them again.
@@ -183,6 +191,8 @@ fn generate(args: &GenerateArgs) -> anyhow::Result<()> {
     if let Some(s) = &args.shard {
         opts.selection = ShardSelection::parse(s)?;
     }
+    opts.only_splits.clone_from(&args.split);
+    opts.only_garments.clone_from(&args.garment);
     opts.max_new_samples = args.max_samples;
     opts.reuse.clone_from(&args.reuse);
     let bar = ProgressBar::new(0);
@@ -206,8 +216,17 @@ fn generate(args: &GenerateArgs) -> anyhow::Result<()> {
         bar.set_message(format!("{} failed", p.failed));
     };
     opts.progress = Some(&progress);
+    let scope: Vec<String> = [("split", &args.split), ("garment", &args.garment)]
+        .iter()
+        .filter(|(_, names)| !names.is_empty())
+        .map(|(what, names)| format!("{what} {}", names.join(",")))
+        .collect();
+    let scope = match scope.is_empty() {
+        true => String::new(),
+        false => format!(" holding a sample of {}", scope.join(" and ")),
+    };
     eprintln!(
-        "generating {} into {} (shards {}, {} jobs)",
+        "generating {} into {} (shards {}{scope}, {} jobs)",
         args.spec.display(),
         args.out.display(),
         opts.selection,

@@ -178,6 +178,43 @@ fn generate_resume_merge_info_show() {
         );
         assert_eq!(x.unwrap(), y.unwrap(), "{name}");
     }
+    // Only the test body's T-shirts: one shard, the same bytes as the whole dataset's.
+    let test_only = d.join("test-only");
+    let args = ["--split", "test", "--garment", "tshirt"];
+    let out = ok(&[
+        &["dataset", "generate", s(&spec), "--out", s(&test_only)][..],
+        &args,
+    ]
+    .concat());
+    assert!(
+        out.contains("0 of 2 selected samples were already made")
+            && out.contains("holding a sample of split test")
+            && out.contains("the selected shards are finished"),
+        "{out}"
+    );
+    let made: Vec<_> = std::fs::read_dir(test_only.join("shards"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(made.len(), 1, "{made:?}");
+    let name = made[0].file_name().unwrap();
+    assert_eq!(
+        std::fs::read(&made[0]).unwrap(),
+        std::fs::read(whole.join("shards").join(name)).unwrap()
+    );
+    let err = fails(&[
+        "dataset",
+        "generate",
+        s(&spec),
+        "--out",
+        s(&test_only),
+        "--split",
+        "tset",
+    ]);
+    assert!(
+        err.contains("no split 'tset' (the splits are test, train)"),
+        "{err}"
+    );
     let out = ok(&["dataset", "info", s(&merged), "--verify"]);
     assert!(
         out.contains("of 6 samples stored") && out.contains("tshirt ok/failed"),

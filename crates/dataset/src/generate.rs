@@ -45,6 +45,12 @@ pub struct GenerateOptions<'a> {
     pub jobs: usize,
     /// The shards this run makes.
     pub selection: ShardSelection,
+    /// Of those, only the shards holding a sample of one of these splits (names; empty:
+    /// any split), say the test split alone for an evaluation.
+    pub only_splits: Vec<String>,
+    /// Of those, only the shards holding a sample of one of these garments (names; empty:
+    /// any garment).
+    pub only_garments: Vec<String>,
     /// The folder clip paths are relative to.
     pub mocap_root: PathBuf,
     /// A dataset of a smaller spec whose samples are taken instead of made again (see
@@ -64,6 +70,8 @@ impl GenerateOptions<'_> {
         Self {
             jobs: std::thread::available_parallelism().map_or(1, |n| n.get()),
             selection: ShardSelection::ALL,
+            only_splits: Vec::new(),
+            only_garments: Vec::new(),
             mocap_root,
             reuse: None,
             max_new_samples: None,
@@ -149,14 +157,9 @@ pub fn generate(
         Some(dir) => Some(Reuse::open(dir, spec, &library)?),
         None => None,
     };
-    let run = crate::run::Run::prepare(
-        out,
-        &plan,
-        &spec.hash,
-        manifest,
-        &opts.selection,
-        reuse.as_ref(),
-    )?;
+    let selection = scoped_selection(&plan, opts)?;
+    let run =
+        crate::run::Run::prepare(out, &plan, &spec.hash, manifest, &selection, reuse.as_ref())?;
     let mut report = GenerateReport {
         total_samples: plan.total(),
         selected_samples: run.progress.total,
@@ -178,7 +181,7 @@ pub fn generate(
     report.made = progress.made;
     report.failed = progress.failed - run.resumed_failed;
     report.finished = (0..plan.shard_count())
-        .filter(|&s| opts.selection.contains(s))
+        .filter(|&s| selection.contains(s))
         .all(|s| manifest.shard(s).is_some());
     report.complete = manifest.complete;
     report.wall_s = t0.elapsed().as_secs_f64();
@@ -272,4 +275,27 @@ fn reconcile(out: &Path, plan: &Plan, m: &mut Manifest, hash: &str) -> Result<()
     }
     m.sort();
     Ok(())
+}
+
+/// `opts.selection` narrowed to the shards that hold a sample of `opts.only_splits` and
+/// `opts.only_garments`; an error when no shard is left.
+fn scoped_selection(plan: &Plan, opts: &GenerateOptions) -> Result<ShardSelection> {
+    if opts.only_splits.is_empty() && opts.only_garments.is_empty() {
+        return Ok(opts.selection.clone());
+    }
+    let shards: Vec<(u64, u64)> = plan
+        .shards_holding(&opts.only_splits, &opts.only_garments)?
+        .into_iter()
+        .filter(|&s| opts.selection.contains(s))
+        .map(|s| (s, s))
+        .collect();
+    if shards.is_empty() {
+        return Err(DatasetError::Invalid(format!(
+            "no shard of the selection {} holds a sample of split(s) [{}] and garment(s) [{}]",
+            opts.selection,
+            opts.only_splits.join(", "),
+            opts.only_garments.join(", ")
+        )));
+    }
+    Ok(ShardSelection::Ranges(shards))
 }

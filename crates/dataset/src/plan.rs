@@ -208,6 +208,42 @@ impl Plan {
         k / self.shard_size
     }
 
+    /// The shards, ascending, that hold at least one sample of a split in `splits` and a
+    /// garment in `garments` (names; an empty list means any). An unknown name is an error
+    /// listing the known ones.
+    pub fn shards_holding(&self, splits: &[String], garments: &[String]) -> Result<Vec<u64>> {
+        let known_splits: Vec<&str> = self.split_names.iter().map(String::as_str).collect();
+        let known_garments: Vec<&str> = self.garments.iter().map(|g| g.name.as_str()).collect();
+        let wanted = |names: &[String], known: &[&str], what: &str| -> Result<Vec<bool>> {
+            if let Some(bad) = names.iter().find(|n| !known.contains(&n.as_str())) {
+                return Err(DatasetError::Invalid(format!(
+                    "no {what} '{bad}' (the {what}s are {})",
+                    known.join(", ")
+                )));
+            }
+            Ok(known
+                .iter()
+                .map(|k| names.is_empty() || names.iter().any(|n| n == k))
+                .collect())
+        };
+        let split_ok = wanted(splits, &known_splits, "split")?;
+        let garment_ok = wanted(garments, &known_garments, "garment")?;
+        let mut shards = std::collections::BTreeSet::new();
+        for (g, garment) in self.garments.iter().enumerate() {
+            if !garment_ok[g] {
+                continue;
+            }
+            let ppb = garment.poses_per_body as u64;
+            for (b, &split) in self.body_split.iter().enumerate() {
+                if split_ok[split] {
+                    let first = self.offsets[g] + b as u64 * ppb;
+                    shards.extend(self.shard_of(first)..=self.shard_of(first + ppb - 1));
+                }
+            }
+        }
+        Ok(shards.into_iter().collect())
+    }
+
     /// Sample `k` (`k < total()`).
     pub fn sample(&self, k: u64) -> SampleDesc {
         assert!(k < self.total(), "sample {k} of {}", self.total());

@@ -147,6 +147,52 @@ fn pool_and_shards_cover_the_samples() {
     assert!((0..p.total()).all(|k| p.shard_range(p.shard_of(k)).contains(&k)));
 }
 
+/// `Plan::shards_holding` (by body ranges) against a plain walk over every sample.
+#[test]
+fn shards_holding_a_split_and_garment_are_those_of_its_samples() {
+    let p = plan(SPEC);
+    let names = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    for (splits, garments) in [
+        (names(&["test"]), names(&[])),
+        (names(&["val"]), names(&["jeans"])),
+        (names(&["val", "test"]), names(&["tshirt"])),
+        (names(&[]), names(&[])),
+    ] {
+        let reference: BTreeSet<u64> = (0..p.total())
+            .map(|k| p.sample(k))
+            .filter(|d| splits.is_empty() || splits.contains(&p.split_names[d.split]))
+            .filter(|d| garments.is_empty() || garments.contains(&p.garments[d.garment].name))
+            .map(|d| p.shard_of(d.index))
+            .collect();
+        let got = p.shards_holding(&splits, &garments).unwrap();
+        assert_eq!(
+            got,
+            reference.into_iter().collect::<Vec<_>>(),
+            "{splits:?} {garments:?}"
+        );
+    }
+    let test_only = p.shards_holding(&names(&["test"]), &[]).unwrap();
+    assert!(!test_only.is_empty() && (test_only.len() as u64) < p.shard_count());
+    for (splits, garments, named) in [
+        (
+            names(&["tset"]),
+            names(&[]),
+            "no split 'tset' (the splits are test, train, val)",
+        ),
+        (
+            names(&[]),
+            names(&["shirt"]),
+            "no garment 'shirt' (the garments are tshirt, jeans)",
+        ),
+    ] {
+        let err = p
+            .shards_holding(&splits, &garments)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(named), "{err}");
+    }
+}
+
 #[test]
 fn datasets_drawing_bodies_alike_share_bodies_split_by_split() {
     let manifest = |text: &str| {
