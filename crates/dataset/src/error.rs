@@ -68,6 +68,23 @@ impl DatasetError {
         }
     }
 
+    /// Errors unless every name in `names` is one of `known` (the names of the dataset's
+    /// splits or garments, `what` saying which), naming the first unknown one and listing
+    /// the known.
+    pub fn check_known<'a>(
+        what: &str,
+        names: impl IntoIterator<Item = &'a str>,
+        known: &[&str],
+    ) -> Result<()> {
+        match names.into_iter().find(|n| !known.contains(n)) {
+            Some(bad) => Err(Self::Invalid(format!(
+                "no {what} '{bad}' (the {what}s are {})",
+                known.join(", ")
+            ))),
+            None => Ok(()),
+        }
+    }
+
     /// A [`DatasetError::Corrupt`] error for `path`.
     pub fn corrupt(path: &Path, message: impl Into<String>) -> Self {
         Self::Corrupt {

@@ -283,12 +283,18 @@ fn scoped_selection(plan: &Plan, opts: &GenerateOptions) -> Result<ShardSelectio
     if opts.only_splits.is_empty() && opts.only_garments.is_empty() {
         return Ok(opts.selection.clone());
     }
-    let shards: Vec<(u64, u64)> = plan
+    // Ascending shards, runs of consecutive ones joined into one range.
+    let mut shards: Vec<(u64, u64)> = Vec::new();
+    for s in plan
         .shards_holding(&opts.only_splits, &opts.only_garments)?
         .into_iter()
         .filter(|&s| opts.selection.contains(s))
-        .map(|s| (s, s))
-        .collect();
+    {
+        match shards.last_mut() {
+            Some((_, end)) if *end + 1 == s => *end = s,
+            _ => shards.push((s, s)),
+        }
+    }
     if shards.is_empty() {
         return Err(DatasetError::Invalid(format!(
             "no shard of the selection {} holds a sample of split(s) [{}] and garment(s) [{}]",

@@ -215,12 +215,7 @@ impl Plan {
         let known_splits: Vec<&str> = self.split_names.iter().map(String::as_str).collect();
         let known_garments: Vec<&str> = self.garments.iter().map(|g| g.name.as_str()).collect();
         let wanted = |names: &[String], known: &[&str], what: &str| -> Result<Vec<bool>> {
-            if let Some(bad) = names.iter().find(|n| !known.contains(&n.as_str())) {
-                return Err(DatasetError::Invalid(format!(
-                    "no {what} '{bad}' (the {what}s are {})",
-                    known.join(", ")
-                )));
-            }
+            DatasetError::check_known(what, names.iter().map(String::as_str), known)?;
             Ok(known
                 .iter()
                 .map(|k| names.is_empty() || names.iter().any(|n| n == k))

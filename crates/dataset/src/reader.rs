@@ -111,20 +111,10 @@ impl Dataset {
     /// An unknown split or garment name is an error listing the known ones.
     pub fn select(&self, split: Option<&str>, garment: Option<&str>) -> Result<Vec<u64>> {
         let m = &self.manifest;
-        if let Some(s) = split.filter(|s| !m.splits.contains_key(*s)) {
-            let known: Vec<&str> = m.splits.keys().map(String::as_str).collect();
-            return Err(DatasetError::Invalid(format!(
-                "no split '{s}' (the splits are {})",
-                known.join(", ")
-            )));
-        }
-        if let Some(g) = garment.filter(|g| !m.garments.iter().any(|x| x.name == *g)) {
-            let known: Vec<&str> = m.garments.iter().map(|x| x.name.as_str()).collect();
-            return Err(DatasetError::Invalid(format!(
-                "no garment '{g}' (the garments are {})",
-                known.join(", ")
-            )));
-        }
+        let splits: Vec<&str> = m.splits.keys().map(String::as_str).collect();
+        DatasetError::check_known("split", split, &splits)?;
+        let garments: Vec<&str> = m.garments.iter().map(|x| x.name.as_str()).collect();
+        DatasetError::check_known("garment", garment, &garments)?;
         Ok(m.samples
             .iter()
             .filter(|e| split.is_none_or(|s| e.record.split == s))
