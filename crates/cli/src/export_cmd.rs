@@ -241,14 +241,7 @@ fn model_card(
             .map_or(String::new(), |h| format!(
                 "- learning rate by epoch (from the run's metrics.csv): {h}\n"
             ))
-            + &if state.averaged_epochs.is_empty() {
-                String::new()
-            } else {
-                format!(
-                    "- weights: the mean of the networks of {} (`garnet average`)\n",
-                    epoch_list(&state.averaged_epochs)
-                )
-            },
+            + &averaged_line(state),
     );
     md += &format!(
         "## Test metrics ('{split}' split of '{name}', `{dir}`: bodies never seen in \
@@ -293,6 +286,31 @@ fn model_card(
         filtered.map_or(String::new(), |(f, _)| filter_flags(f))
     );
     Ok(md)
+}
+
+/// The model card's line on how an averaged network was made from its runs' networks
+/// (`garnet average`): the plain mean of their epochs, or each epoch with its weight; empty
+/// for a network trained as it is.
+fn averaged_line(state: &model::TrainState) -> String {
+    if state.averaged_epochs.is_empty() {
+        String::new()
+    } else if state.averaged_weights.is_empty() {
+        format!(
+            "- weights: the mean of the networks of {} (`garnet average`)\n",
+            epoch_list(&state.averaged_epochs)
+        )
+    } else {
+        let terms: Vec<String> = state
+            .averaged_weights
+            .iter()
+            .zip(&state.averaged_epochs)
+            .map(|(w, e)| format!("{w} x epoch {e}"))
+            .collect();
+        format!(
+            "- weights: the combination {} of networks (`garnet average --weights`)\n",
+            terms.join(" + ")
+        )
+    }
 }
 
 /// The learning rates of a training log (`metrics.csv` text) as segments of epochs: a

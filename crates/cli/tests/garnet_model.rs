@@ -662,6 +662,53 @@ fn average_writes_a_checkpoint_that_exports() {
     );
     let err = fails(&["average", "--models", s(&snapshots[0]), "--out", s(&mean)]);
     assert!(err.contains("--models"), "{err}");
+
+    // Weights: a weighted combination (here an extrapolation) that the card spells out;
+    // weights that do not sum to 1 are refused and write nothing.
+    let combined = tmp.path().join("combined.garnet");
+    let pair = [s(&snapshots[0]), s(&snapshots[1])];
+    let log = ok(&[
+        "average",
+        "--models",
+        pair[0],
+        pair[1],
+        "--weights",
+        "-0.5,1.5",
+        "--out",
+        s(&combined),
+    ]);
+    assert!(
+        log.contains("the combination with weights [-0.5, 1.5]"),
+        "{log}"
+    );
+    let card_model = tmp.path().join("models").join("tshirt-naive-x.garnet");
+    ok(&[
+        "export",
+        "--model",
+        s(&combined),
+        "--data",
+        s(data),
+        "--out",
+        s(&card_model),
+    ]);
+    let card = std::fs::read_to_string(card_model.with_extension("md")).unwrap();
+    assert!(
+        card.contains("the combination -0.5 x epoch 1 + 1.5 x epoch 2 of networks"),
+        "{card}"
+    );
+    let bad = tmp.path().join("bad.garnet");
+    let err = fails(&[
+        "average",
+        "--models",
+        pair[0],
+        pair[1],
+        "--weights",
+        "0.5,0.6",
+        "--out",
+        s(&bad),
+    ]);
+    assert!(err.contains("sum to"), "{err}");
+    assert!(!bad.exists());
 }
 
 /// `garnet grow`: the grown and the widened checkpoints evaluate as their parent, and `garnet

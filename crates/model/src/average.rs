@@ -83,6 +83,23 @@ impl ModuleMapper for Replace {
 /// device of the first: each parameter is the mean of the networks' values, summed in f64.
 /// Networks whose parameters differ in number or shape are an error.
 pub fn average_networks(networks: &[GarNet]) -> Result<GarNet> {
+    weighted_sum(networks, &vec![1.0; networks.len()], networks.len() as f64)
+}
+
+/// The affine combination `sum_k weights[k] * networks[k]` of networks of one architecture,
+/// element by element, summed in f64, on the device of the first. The weights (one per
+/// network, finite, summing to 1 within 1e-6) may be unequal, to weigh some snapshots more,
+/// or negative, to extrapolate along the line from one network through another
+/// (`[-1, 2]`: twice the step from the first to the second). Other weights, and networks
+/// whose parameters differ in number or shape, are an error.
+pub fn combine_networks(networks: &[GarNet], weights: &[f64]) -> Result<GarNet> {
+    check_weights(weights, networks.len())?;
+    weighted_sum(networks, weights, 1.0)
+}
+
+/// `sum_k weights[k] * networks[k] / divisor`, element by element, summed in f64 (the mean
+/// divides once at the end, so that it stays the plain mean bit for bit).
+fn weighted_sum(networks: &[GarNet], weights: &[f64], divisor: f64) -> Result<GarNet> {
     let first = networks
         .first()
         .ok_or_else(|| ModelError::InvalidInput("no networks to average".into()))?;
@@ -90,7 +107,7 @@ pub fn average_networks(networks: &[GarNet]) -> Result<GarNet> {
         .into_iter()
         .map(|p| (p.shape, vec![0.0; p.values.len()]))
         .collect();
-    for (k, net) in networks.iter().enumerate() {
+    for (k, (net, &w)) in networks.iter().zip(weights).enumerate() {
         let params = parameter_values(net)?;
         if params.len() != sums.len() {
             return Err(ModelError::InvalidInput(format!(
@@ -110,21 +127,43 @@ pub fn average_networks(networks: &[GarNet]) -> Result<GarNet> {
                 )));
             }
             for (s, &v) in sum.iter_mut().zip(&p.values) {
-                *s += v as f64;
+                *s += w * v as f64;
             }
         }
     }
-    let n = networks.len() as f64;
-    let means: Vec<ParamValues> = sums
+    let combined: Vec<ParamValues> = sums
         .into_iter()
         .map(|(shape, sum)| ParamValues {
             shape,
-            values: sum.into_iter().map(|s| (s / n) as f32).collect(),
+            values: sum.into_iter().map(|s| (s / divisor) as f32).collect(),
         })
         .collect();
     Ok(first.clone().map(&mut Replace {
-        next: means.into_iter(),
+        next: combined.into_iter(),
     }))
+}
+
+/// Checks that `weights` are `n` finite numbers summing to 1 (within 1e-6): an affine
+/// combination, so a network combined with itself stays itself.
+fn check_weights(weights: &[f64], n: usize) -> Result<()> {
+    if weights.len() != n {
+        return Err(ModelError::InvalidInput(format!(
+            "{} weights for {n} networks: give one weight per network",
+            weights.len()
+        )));
+    }
+    if let Some(w) = weights.iter().find(|w| !w.is_finite()) {
+        return Err(ModelError::InvalidInput(format!(
+            "weight {w} is not a finite number"
+        )));
+    }
+    let total: f64 = weights.iter().sum();
+    if (total - 1.0).abs() > 1e-6 {
+        return Err(ModelError::InvalidInput(format!(
+            "the weights {weights:?} sum to {total}, not 1"
+        )));
+    }
+    Ok(())
 }
 
 /// What [`average_checkpoints`] wrote.
@@ -138,15 +177,25 @@ pub struct AverageReport {
 
 /// Averages the networks of the checkpoints `inputs` (at least two, each written for the
 /// same setup and loss: architecture, template, body sampling) and writes the mean network
-/// to `out` without optimiser state (a resumed run starts Adam afresh). The written
+/// to `out` without optimiser state (a resumed run starts Adam afresh). With `weights`
+/// (one per input, summing to 1; see [`combine_networks`]) it writes that weighted
+/// combination instead of the plain mean. The written
 /// progress is the last input's, without a best validation figure, and its command is the
 /// last input's followed by `command`.
-pub fn average_checkpoints(inputs: &[&Path], out: &Path, command: &str) -> Result<AverageReport> {
+pub fn average_checkpoints(
+    inputs: &[&Path],
+    weights: Option<&[f64]>,
+    out: &Path,
+    command: &str,
+) -> Result<AverageReport> {
     if inputs.len() < 2 {
         return Err(ModelError::InvalidInput(format!(
             "averaging needs at least two checkpoints, got {}",
             inputs.len()
         )));
+    }
+    if let Some(w) = weights {
+        check_weights(w, inputs.len())?;
     }
     let device = Device::flex();
     let mut networks = Vec::with_capacity(inputs.len());
@@ -177,10 +226,14 @@ pub fn average_checkpoints(inputs: &[&Path], out: &Path, command: &str) -> Resul
         reference = Some((ck.setup, ck.loss, ck.state));
     }
     let (setup, loss, mut state) = reference.expect("at least two inputs");
-    let mean = average_networks(&networks)?;
+    let mean = match weights {
+        Some(w) => combine_networks(&networks, w)?,
+        None => average_networks(&networks)?,
+    };
     state.best_e_dist_cm = None;
     state.validation = None;
     state.averaged_epochs = epochs.clone();
+    state.averaged_weights = weights.map(<[f64]>::to_vec).unwrap_or_default();
     state.append_command(command);
     save_checkpoint(out, &mean, None, &setup, &loss, &state)?;
     Ok(AverageReport {
@@ -222,6 +275,45 @@ mod tests {
         let mean = average_networks(&[a.clone(), a.clone(), a.clone()]).unwrap();
         assert_eq!(
             parameter_values(&mean).unwrap(),
+            parameter_values(&a).unwrap()
+        );
+    }
+
+    #[test]
+    fn weighted_combination_matches_a_plain_loop() {
+        let (a, b, c) = (net(1), net(2), net(3));
+        let weights = [-0.5, 1.25, 0.25];
+        let (pa, pb, pc) = (
+            parameter_values(&a).unwrap(),
+            parameter_values(&b).unwrap(),
+            parameter_values(&c).unwrap(),
+        );
+        let combined = parameter_values(&combine_networks(&[a, b, c], &weights).unwrap()).unwrap();
+        for (i, m) in combined.iter().enumerate() {
+            for (j, &m) in m.values.iter().enumerate() {
+                let (x, y, z) = (pa[i].values[j], pb[i].values[j], pc[i].values[j]);
+                let expected =
+                    (weights[0] * x as f64 + weights[1] * y as f64 + weights[2] * z as f64) as f32;
+                assert_eq!(m.to_bits(), expected.to_bits());
+            }
+        }
+    }
+
+    #[test]
+    fn weights_must_be_one_per_network_and_sum_to_one() {
+        let (a, b) = (net(1), net(2));
+        let nets = [a.clone(), b];
+        for (weights, says) in [
+            (vec![1.0], "1 weights for 2 networks"),
+            (vec![0.5, 0.6], "sum to"),
+            (vec![f64::NAN, 1.0], "not a finite number"),
+        ] {
+            let err = combine_networks(&nets, &weights).unwrap_err().to_string();
+            assert!(err.contains(says), "{err}");
+        }
+        let same = combine_networks(&[a.clone(), a.clone()], &[-1.0, 2.0]).unwrap();
+        assert_eq!(
+            parameter_values(&same).unwrap(),
             parameter_values(&a).unwrap()
         );
     }

@@ -210,6 +210,10 @@ pub struct TrainState {
     /// empty for a network trained as it is (cleared by the next training epoch).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub averaged_epochs: Vec<usize>,
+    /// The weights of those networks, one per entry of `averaged_epochs`, when they were
+    /// combined with weights (`garnet average --weights`); empty for the plain mean.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub averaged_weights: Vec<f64>,
     /// The command line of the latest training run (for model cards), when it was given.
     #[serde(default)]
     pub command: Option<String>,

@@ -66,7 +66,7 @@ pub mod trainer;
 pub mod widen;
 
 pub use alloc::tune_allocator;
-pub use average::{average_checkpoints, average_networks, AverageReport};
+pub use average::{average_checkpoints, average_networks, combine_networks, AverageReport};
 pub use batch::{Batch, BodyTopology, InputSpec, KnownBodies, NetInputs, Sample};
 pub use checkpoint::{load_checkpoint, save_checkpoint, Checkpoint, ModelSetup, TrainState};
 pub use config::{GarNetConfig, Variant};

@@ -447,6 +447,7 @@ impl Trainer {
         }
         let (train_terms, train_samples, grad_norm) = self.train_epoch(train)?;
         self.state.averaged_epochs.clear();
+        self.state.averaged_weights.clear();
         let validation = match valid {
             Some(v) => Some(self.validate(v)?),
             None => None,

@@ -829,7 +829,7 @@ fn averaged_checkpoint_holds_the_mean_network() {
         .collect();
     let inputs: Vec<&std::path::Path> = snapshots.iter().map(|p| p.as_path()).collect();
     let out = dir.path().join("mean.garnet");
-    let report = average_checkpoints(&inputs, &out, "garnet average").unwrap();
+    let report = average_checkpoints(&inputs, None, &out, "garnet average").unwrap();
     assert_eq!(report.epochs, vec![1, 2, 3]);
     let mean = load_checkpoint(&out).unwrap();
     assert!(!mean.has_optimizer());
@@ -851,13 +851,26 @@ fn averaged_checkpoint_holds_the_mean_network() {
     assert_eq!(got, expected);
     assert_ne!(got, model::average::parameter_values(&nets[2]).unwrap());
 
+    // Weights give the weighted combination; weights that do not sum to 1 are refused.
+    let weights = [0.25, -0.25, 1.0];
+    average_checkpoints(&inputs, Some(&weights), &out, "garnet average").unwrap();
+    let expected = combine_networks(&nets, &weights).unwrap();
+    assert_eq!(
+        checkpoint_params(&out, &device),
+        model::average::parameter_values(&expected).unwrap()
+    );
+    let err = average_checkpoints(&inputs, Some(&[0.5, 0.5, 0.5]), &out, "x")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("sum to"), "{err}");
+
     // One input, or inputs of another garment template, are refused.
-    assert!(average_checkpoints(&inputs[..1], &out, "x").is_err());
+    assert!(average_checkpoints(&inputs[..1], None, &out, "x").is_err());
     let other = dir.path().join("other.garnet");
     let s2 = setup(Variant::Global, 90);
     let t2 = Trainer::new(s2, LossConfig::new(), 1e-3, &device).unwrap();
     t2.save(&other).unwrap();
-    let err = average_checkpoints(&[inputs[0], &other], &out, "x")
+    let err = average_checkpoints(&[inputs[0], &other], None, &out, "x")
         .unwrap_err()
         .to_string();
     assert!(err.contains("not averageable"), "{err}");
