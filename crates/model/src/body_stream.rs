@@ -11,11 +11,15 @@
 use burn::nn::Linear;
 use burn::prelude::*;
 
+use rayon::prelude::*;
+
 use crate::config::GarNetConfig;
+use crate::error::Result;
 use crate::init::ParamInit;
 use crate::layers::{lrelu, max_points, maximum, PointMlp};
 use crate::local::LocalIndices;
 use crate::stn::Stn;
+use crate::tensors::{read_f32, read_i64, untracked_on_flex, vec_tensor};
 
 /// PointNet body stream.
 #[derive(Module, Debug)]
@@ -98,16 +102,62 @@ impl LocalPool {
         // Max over the k nearest kept points, one [B*N, L] gather per neighbour rank (no
         // [B*N*k, L] intermediate), with `maximum` (exact, the gradient to one side).
         let table = local.reshape([b * s, l]);
-        let gathered = idx
-            .knn
-            .iter()
-            .map(|col| table.clone().select(0, col.clone()));
-        match gathered.reduce(|acc, t| maximum(t, acc)) {
-            Some(acc) => acc.reshape([b, n, l]),
+        if idx.knn.is_empty() {
             // No neighbour (knn_k = 0, refused by GarNet::translations): no local feature.
-            None => Tensor::zeros([b, n, l], &table.device()),
+            return Tensor::zeros([b, n, l], &table.device());
         }
+        let pooled = if untracked_on_flex(&table) {
+            max_pool_rows(&table, &idx.knn).unwrap_or_else(|_| max_pool_tensors(table, &idx.knn))
+        } else {
+            max_pool_tensors(table, &idx.knn)
+        };
+        pooled.reshape([b, n, l])
     }
+}
+
+/// The max pooling of [`LocalPool::forward`] with burn's ops: the kept-point table `[R,L]`
+/// and `knn` columns (at least one) `[B*N]` of its rows -> `[B*N,L]`, the element-wise
+/// maximum of each garment vertex's rows, one `[B*N,L]` gather per neighbour rank (no
+/// `[B*N*k,L]` intermediate) with `maximum` (exact, the gradient to one side). Used whenever
+/// gradients flow, and on the GPU backends.
+fn max_pool_tensors(table: Tensor<2>, knn: &[Tensor<1, Int>]) -> Tensor<2> {
+    knn.iter()
+        .map(|col| table.clone().select(0, col.clone()))
+        .reduce(|acc, t| maximum(t, acc))
+        .expect("at least one neighbour column")
+}
+
+/// [`max_pool_tensors`] as plain loops (in parallel over the garment vertices) for an
+/// untracked CPU table `[R,L]` and `knn` columns `[B*N]` of row indices:
+/// `[B*N,L]`, row r the element-wise maximum of the rows `knn[0][r]`, `knn[1][r]`, ...,
+/// compared as `maximum` does (a later row wins only where it is greater), so the values are
+/// bit for bit those of the tensor path. Written by hand because flex's `max_pair` is a
+/// masked select, ~10% of a 10k-vertex drape with the gathers (`perf`, docs/model.md
+/// "Speed").
+fn max_pool_rows(table: &Tensor<2>, knn: &[Tensor<1, Int>]) -> Result<Tensor<2>> {
+    let l = table.dims()[1];
+    let values = read_f32(table.clone())?;
+    let columns = knn
+        .iter()
+        .map(|c| read_i64(c.clone()))
+        .collect::<Result<Vec<_>>>()?;
+    let rows = columns.first().map_or(0, Vec::len);
+    let mut out = vec![0.0f32; rows * l];
+    out.par_chunks_mut(l).enumerate().for_each(|(r, dst)| {
+        for (c, column) in columns.iter().enumerate() {
+            let src = &values[column[r] as usize * l..][..l];
+            if c == 0 {
+                dst.copy_from_slice(src);
+            } else {
+                for (a, &v) in dst.iter_mut().zip(src) {
+                    if v > *a {
+                        *a = v;
+                    }
+                }
+            }
+        }
+    });
+    Ok(vec_tensor(out, [rows, l], &table.device()))
 }
 
 #[cfg(test)]
@@ -119,6 +169,31 @@ mod tests {
     use rand::{Rng, SeedableRng};
 
     /// Local pooling against loops over the tables, for a batch of two different bodies.
+    /// The loops of `max_pool_rows` (drapes, evaluation) give the values of the tensor path
+    /// (training) bit for bit, ties and repeated rows included.
+    #[test]
+    fn max_pool_loops_match_the_tensor_path() {
+        let device = Device::flex();
+        let (rows, l, n) = (9, 6, 40);
+        let mut rng = rand::rngs::StdRng::seed_from_u64(4);
+        // Values on a coarse grid, so that many compared pairs tie.
+        let table: Vec<f32> = (0..rows * l)
+            .map(|_| rng.random_range(-4..4) as f32 * 0.5)
+            .collect();
+        let table = vec_tensor(table, [rows, l], &device);
+        let knn: Vec<Tensor<1, Int>> = (0..5)
+            .map(|_| {
+                let col: Vec<i64> = (0..n).map(|_| rng.random_range(0..rows as i64)).collect();
+                crate::tensors::index_tensor(col, &device)
+            })
+            .collect();
+        let loops = read_f32(max_pool_rows(&table, &knn).unwrap()).unwrap();
+        let tensors = read_f32(max_pool_tensors(table, &knn)).unwrap();
+        assert_eq!(loops.len(), n * l);
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&loops), bits(&tensors));
+    }
+
     #[test]
     fn local_pool_matches_a_plain_loop() {
         let device = Device::flex();

@@ -53,6 +53,18 @@ pub fn points_tensor(samples: &[&[Vec3]], device: &Device) -> Tensor<3> {
     vec_tensor(flat, [b, n, 3], device)
 }
 
+/// Whether `t` lives on the CPU (`flex`) with no gradient tracked through it: where a plain
+/// loop over its values (read back without a transfer) can stand in for burn's ops.
+pub fn untracked_on_flex<const D: usize>(t: &Tensor<D>) -> bool {
+    !t.is_tracked() && t.device() == Device::flex()
+}
+
+/// Reads an int tensor back as row-major i64 values.
+pub fn read_i64(t: Tensor<1, Int>) -> Result<Vec<i64>> {
+    t.try_into_vec_as::<i64>()
+        .map_err(|e| ModelError::Backend(format!("{e:?}")))
+}
+
 /// Reads a float tensor back as row-major f32 values.
 pub fn read_f32<const D: usize>(t: Tensor<D>) -> Result<Vec<f32>> {
     t.try_into_vec_as::<f32>()
