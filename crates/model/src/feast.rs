@@ -136,8 +136,8 @@ fn aggregate_tensors(x: Tensor<3>, ring: &Tensor<1, Int>, q: Tensor<4>) -> Tenso
 }
 
 /// [`aggregate_tensors`] as plain loops over the vertices (in parallel), for untracked
-/// tensors on the CPU: the same `[B,N,d_in*M]` values, summed over the neighbours in the
-/// same order. Written by hand because flex allocates every matrix product's output zeroed
+/// tensors on the CPU: the same `[B,N,d_in*M]` values (summed over the neighbours in ring
+/// order, so equal to the products' within rounding). Written by hand because flex allocates every matrix product's output zeroed
 /// and then copies it once more to align it: on a 10k-vertex garment that was ~16% of a
 /// GarNet-Local drape, with hardly any arithmetic (`perf`, docs/model.md "Speed").
 fn aggregate_rows(x: &Tensor<3>, ring: &Tensor<1, Int>, q: &Tensor<4>) -> Result<Tensor<3>> {
@@ -148,6 +148,9 @@ fn aggregate_rows(x: &Tensor<3>, ring: &Tensor<1, Int>, q: &Tensor<4>) -> Result
     let ring = read_i64(ring.clone())?;
     let width = d_in * m;
     let len = b * n * width;
+    if len == 0 {
+        return Ok(vec_tensor(Vec::new(), [b, n, width], &x.device()));
+    }
     let mut out: Vec<f32> = Vec::with_capacity(len);
     out.spare_capacity_mut()[..len]
         .par_chunks_mut(width)
@@ -178,7 +181,6 @@ fn aggregate_rows(x: &Tensor<3>, ring: &Tensor<1, Int>, q: &Tensor<4>) -> Result
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tensors::{read_f32, vec_tensor};
     use crate::topology::GarmentTopology;
     use rand::{Rng, SeedableRng};
 
