@@ -630,17 +630,11 @@ fn average_writes_a_checkpoint_that_exports() {
         assert_eq!(md.matches(&row).count(), 3, "{row}\n{md}");
     }
     assert_eq!(md.matches("| tshirt | DQS |").count(), 1, "{md}");
-    let card_model = tmp.path().join("models").join("tshirt-naive.garnet");
-    ok(&[
-        "export",
-        "--model",
-        s(&mean),
-        "--data",
-        s(data),
-        "--out",
-        s(&card_model),
-    ]);
-    let card = std::fs::read_to_string(card_model.with_extension("md")).unwrap();
+    let card = exported_card(
+        &mean,
+        data,
+        &tmp.path().join("models").join("tshirt-naive.garnet"),
+    );
     assert!(
         card.contains("- weights: the mean of the networks of epochs 1-2 (`garnet average`)")
             && card.contains("; then garnet average --models"),
@@ -681,17 +675,11 @@ fn average_writes_a_checkpoint_that_exports() {
         log.contains("the combination with weights [-0.5, 1.5]"),
         "{log}"
     );
-    let card_model = tmp.path().join("models").join("tshirt-naive-x.garnet");
-    ok(&[
-        "export",
-        "--model",
-        s(&combined),
-        "--data",
-        s(data),
-        "--out",
-        s(&card_model),
-    ]);
-    let card = std::fs::read_to_string(card_model.with_extension("md")).unwrap();
+    let card = exported_card(
+        &combined,
+        data,
+        &tmp.path().join("models").join("tshirt-naive-x.garnet"),
+    );
     assert!(
         card.contains("the combination -0.5 x epoch 1 + 1.5 x epoch 2 of networks"),
         "{card}"
@@ -709,6 +697,21 @@ fn average_writes_a_checkpoint_that_exports() {
     ]);
     assert!(err.contains("sum to"), "{err}");
     assert!(!bad.exists());
+}
+
+/// Exports `model` as `out` with `data`'s test metrics and returns the model card written
+/// beside it.
+fn exported_card(model: &Path, data: &Path, out: &Path) -> String {
+    ok(&[
+        "export",
+        "--model",
+        s(model),
+        "--data",
+        s(data),
+        "--out",
+        s(out),
+    ]);
+    std::fs::read_to_string(out.with_extension("md")).unwrap()
 }
 
 /// `garnet grow`: the grown and the widened checkpoints evaluate as their parent, and `garnet
