@@ -107,33 +107,101 @@ pub fn ray_triangle(
     b: Vec3,
     c: Vec3,
 ) -> Option<(f32, [f32; 3])> {
-    let (o, d, a) = (origin.as_dvec3(), dir.as_dvec3(), a.as_dvec3());
-    let e1 = b.as_dvec3() - a;
-    let e2 = c.as_dvec3() - a;
-    let h = d.cross(e2);
-    let det = e1.dot(h);
-    // det is the triple product of e1, dir, e2; relative to their lengths it measures how far
-    // the ray is from parallel to the triangle's plane.
-    let scale = e1.length() * e2.length() * d.length();
-    if !det.is_finite() || det.abs() <= 1e-10 * scale {
+    let r = RayPlane::new(origin, dir, a, b, c);
+    if !r.det.is_finite() || r.det.abs() <= 1e-10 * r.scale {
         return None;
     }
-    let inv = 1.0 / det;
-    let s = o - a;
-    let u = inv * s.dot(h);
-    if !(0.0..=1.0).contains(&u) {
+    if !(0.0..=1.0).contains(&r.u) || r.v < 0.0 || r.u + r.v > 1.0 {
         return None;
     }
-    let q = s.cross(e1);
-    let v = inv * d.dot(q);
-    if v < 0.0 || u + v > 1.0 {
+    if !(0.0..=t_max as f64).contains(&r.t) {
         return None;
     }
-    let t = inv * e2.dot(q);
-    if !(0.0..=t_max as f64).contains(&t) {
-        return None;
+    Some((
+        r.t as f32,
+        [(1.0 - r.u - r.v) as f32, r.u as f32, r.v as f32],
+    ))
+}
+
+/// Where a ray meets the plane of a triangle, in f64 (Moeller-Trumbore): the crossing is
+/// `origin + t dir = a + u (b - a) + v (c - a)`. `t`, `u` and `v` are meaningless (inf or
+/// NaN) when `det` is 0 or not finite.
+struct RayPlane {
+    /// Triple product of the edges `b - a`, `c - a` and `dir`.
+    det: f64,
+    /// `|b - a| |c - a| |dir|`: `det / scale` is the sine-like measure of how far the ray is
+    /// from parallel to the plane.
+    scale: f64,
+    t: f64,
+    u: f64,
+    v: f64,
+}
+
+impl RayPlane {
+    #[inline]
+    fn new(origin: Vec3, dir: Vec3, a: Vec3, b: Vec3, c: Vec3) -> RayPlane {
+        let (o, d, a) = (origin.as_dvec3(), dir.as_dvec3(), a.as_dvec3());
+        let e1 = b.as_dvec3() - a;
+        let e2 = c.as_dvec3() - a;
+        let h = d.cross(e2);
+        let det = e1.dot(h);
+        let scale = e1.length() * e2.length() * d.length();
+        let inv = 1.0 / det;
+        let s = o - a;
+        let q = s.cross(e1);
+        RayPlane {
+            det,
+            scale,
+            t: inv * e2.dot(q),
+            u: inv * s.dot(h),
+            v: inv * d.dot(q),
+        }
     }
-    Some((t as f32, [(1.0 - u - v) as f32, u as f32, v as f32]))
+}
+
+/// How the ray `origin + t dir`, `t > 0`, meets a triangle, told apart with a margin so that
+/// a count of crossings along the ray can be trusted (see [`ray_crossing`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RayCrossing {
+    /// Clear of the triangle (or of its plane behind the origin) by more than the margin.
+    Miss,
+    /// Through the triangle's interior, at least the margin from its edges, `t` (in units
+    /// of `dir`) beyond the origin.
+    Through(f32),
+    /// Too close to call: within the margin of an edge, a vertex or the origin, or nearly
+    /// parallel to the plane. [`ray_triangle`] may go either way here, and a neighbour face
+    /// may too, so a crossing count along this ray is not to be trusted.
+    Grazing,
+}
+
+/// [`ray_triangle`] for an unbounded ray (`t > 0`), with a margin: a barycentric weight
+/// within `margin` of 0, a `t` within `margin` of 0, or a ray within about `1e-5` rad of the
+/// plane (where the f32 orientation sign of a crossing is unreliable) gives
+/// [`RayCrossing::Grazing`]. When the answer is [`RayCrossing::Through`] or
+/// [`RayCrossing::Miss`], [`ray_triangle`] with `t_max = inf` gives the same (a hit with a
+/// positive `t`, or none with a positive `t`).
+#[inline]
+pub fn ray_crossing(
+    origin: Vec3,
+    dir: Vec3,
+    a: Vec3,
+    b: Vec3,
+    c: Vec3,
+    margin: f64,
+) -> RayCrossing {
+    let r = RayPlane::new(origin, dir, a, b, c);
+    if !r.det.is_finite() || r.det.abs() <= 1e-5 * r.scale {
+        return RayCrossing::Grazing;
+    }
+    let w = 1.0 - r.u - r.v;
+    let lowest = r.u.min(r.v).min(w);
+    if lowest < -margin || r.t < -margin {
+        return RayCrossing::Miss;
+    }
+    if lowest <= margin || r.t <= margin {
+        return RayCrossing::Grazing;
+    }
+    RayCrossing::Through(r.t as f32)
 }
 
 /// Intersection of the segment `[p, q]` with triangle `(a, b, c)`: `Some((t, bary))` with the
@@ -196,6 +264,47 @@ mod tests {
             let r = w[0] * a + w[1] * b + w[2] * c;
             assert!((r - q).length() < 1e-6 && (w.iter().sum::<f32>() - 1.0).abs() < 1e-6);
         }
+    }
+
+    #[test]
+    fn a_crossing_called_through_or_miss_is_what_ray_triangle_finds() {
+        let (a, b, c) = (
+            Vec3::ZERO,
+            Vec3::new(1.0, 0.1, 0.0),
+            Vec3::new(0.2, 1.0, 0.3),
+        );
+        let mut seen = [0usize; 3];
+        let mut x = 0.37f32;
+        let mut next = || {
+            x = (x * 997.0 + 0.31).fract();
+            x
+        };
+        for i in 0..20000 {
+            let o = Vec3::new(next() * 2.0 - 0.5, next() * 2.0 - 0.5, next() * 2.0 - 1.0);
+            // Rays at random, rays aimed at the edges and vertices, rays along the plane.
+            let target = match i % 4 {
+                0 => a.lerp(b, next()),
+                1 => [a, b, c][i % 3],
+                _ => Vec3::new(next(), next(), next() * 0.3),
+            };
+            let mut d = (target - o).normalize();
+            if i % 50 == 0 {
+                d = (b - a).normalize();
+            }
+            let plain = ray_triangle(o, d, f32::INFINITY, a, b, c).filter(|h| h.0 > 0.0);
+            match ray_crossing(o, d, a, b, c, 1e-9) {
+                RayCrossing::Through(t) => {
+                    assert_eq!(plain.map(|h| h.0), Some(t), "{o} {d}");
+                    seen[0] += 1;
+                }
+                RayCrossing::Miss => {
+                    assert_eq!(plain, None, "{o} {d}");
+                    seen[1] += 1;
+                }
+                RayCrossing::Grazing => seen[2] += 1,
+            }
+        }
+        assert!(seen.iter().all(|&k| k > 100), "{seen:?}");
     }
 
     #[test]

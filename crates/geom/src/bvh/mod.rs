@@ -15,6 +15,7 @@ mod build;
 mod closest;
 mod inside;
 mod segment;
+mod slab;
 
 use glam::Vec3;
 

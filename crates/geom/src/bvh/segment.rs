@@ -3,7 +3,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::inside::ray_box;
+use super::slab::Slabs;
 use super::Bvh;
 use crate::tri::segment_triangle;
 
@@ -28,36 +28,20 @@ impl Bvh {
         skip_vertices: &[u32],
         mut hit: impl FnMut(SegmentHit) -> bool,
     ) {
-        if self.nodes.is_empty() || !a.is_finite() || !b.is_finite() {
+        if !a.is_finite() || !b.is_finite() {
             return;
         }
-        let d = b - a;
-        let inv = d.recip();
-        let mut stack: Vec<u32> = Vec::with_capacity(64);
-        stack.push(0);
-        while let Some(ni) = stack.pop() {
-            let n = &self.nodes[ni as usize];
-            if !ray_box(n, a, d, inv, 1.0) {
-                continue;
+        self.for_each_face_on_ray(&Slabs::new(a, b - a, 1.0), |fi| {
+            let f = &self.faces[fi as usize];
+            if f.iter().any(|v| skip_vertices.contains(v)) {
+                return true;
             }
-            if n.is_leaf() {
-                for &fi in self.leaf_faces(n) {
-                    let f = &self.faces[fi as usize];
-                    if f.iter().any(|v| skip_vertices.contains(v)) {
-                        continue;
-                    }
-                    let [p, q, r] = self.tri(fi);
-                    if let Some((t, bary)) = segment_triangle(a, b, p, q, r) {
-                        if !hit(SegmentHit { face: fi, t, bary }) {
-                            return;
-                        }
-                    }
-                }
-            } else {
-                stack.push(n.start);
-                stack.push(n.start + 1);
+            let [p, q, r] = self.tri(fi);
+            match segment_triangle(a, b, p, q, r) {
+                Some((t, bary)) => hit(SegmentHit { face: fi, t, bary }),
+                None => true,
             }
-        }
+        });
     }
 
     /// Faces crossed by the segment `[a, b]` (metres), sorted by `t` then face, skipping
