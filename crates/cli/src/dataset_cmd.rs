@@ -8,6 +8,8 @@ use clap::{Args, Subcommand};
 use dataset::{Dataset, GenerateOptions, LoadedSpec, Plan, ShardSelection, Summary};
 use indicatif::{ProgressBar, ProgressStyle};
 
+use crate::log_lines::{LogLines, LOG_EVERY};
+
 /// `garnet dataset` subcommands.
 #[derive(Subcommand, Debug)]
 pub enum DatasetCmd {
@@ -204,7 +206,15 @@ fn generate(args: &GenerateArgs) -> anyhow::Result<()> {
         .progress_chars("=> "),
     );
     let started = std::sync::atomic::AtomicBool::new(false);
+    // Without a terminal (a log file) the bar is hidden: a line every few minutes instead.
+    let log = std::sync::Mutex::new(LogLines::new(LOG_EVERY, "samples"));
     let progress = |p: &dataset::Progress| {
+        if bar.is_hidden() {
+            let mut log = log.lock().unwrap_or_else(|e| e.into_inner());
+            if let Some(line) = log.line(std::time::Instant::now(), p.done, p.total) {
+                eprintln!("{line}; {} failed", p.failed);
+            }
+        }
         if !started.swap(true, std::sync::atomic::Ordering::SeqCst) {
             // The rate and ETA count from the first sample of this run.
             bar.set_length(p.total);

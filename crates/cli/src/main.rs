@@ -17,6 +17,7 @@ mod export_cmd;
 mod garment_cmd;
 mod garment_sheet;
 mod grow_cmd;
+mod log_lines;
 mod model_device;
 mod output;
 mod pose_args;

@@ -3,6 +3,7 @@
 //! and a metrics log (`metrics.csv`).
 
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 use anyhow::{bail, Context};
 use burn::module::Module;
@@ -16,6 +17,7 @@ use model::{
 };
 
 use crate::drape_filter_args::{keep_drapes, DrapeFilterArgs};
+use crate::log_lines::{LogLines, LOG_EVERY};
 use crate::model_device::DeviceArg;
 
 /// Arguments of `garnet train`.
@@ -374,6 +376,8 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
         bar.set_prefix((epoch + 1).to_string());
         bar.reset();
         let bar = bar.clone();
+        // Without a terminal (a log file) the bar is hidden: a line every few minutes.
+        let mut log = LogLines::new(LOG_EVERY, "batches");
         train
             .batches(
                 args.batch,
@@ -382,7 +386,15 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
                     epoch: epoch as u64,
                 },
             )
-            .inspect(move |_| bar.inc(1))
+            .inspect(move |_| {
+                bar.inc(1);
+                if bar.is_hidden() {
+                    let line = log.line(Instant::now(), bar.position(), batches_per_epoch);
+                    if let Some(line) = line {
+                        eprintln!("epoch {}: {line}", epoch + 1);
+                    }
+                }
+            })
     };
     let valid_batches = valid
         .as_ref()
