@@ -7,9 +7,9 @@ use super::{Bvh, Node};
 
 /// A ray `o + t d`, `t in [0, t_max]`, set up for slab tests against many boxes.
 pub(super) struct Slabs {
-    o: Vec3,
-    d: Vec3,
-    inv: Vec3,
+    o: Vec3A,
+    d: Vec3A,
+    inv: Vec3A,
     t_max: f32,
     /// Every component of `d` has a finite, non-zero reciprocal, so the SIMD test applies.
     general: bool,
@@ -20,9 +20,9 @@ impl Slabs {
     pub(super) fn new(o: Vec3, d: Vec3, t_max: f32) -> Slabs {
         let inv = d.recip();
         Slabs {
-            o,
-            d,
-            inv,
+            o: o.into(),
+            d: d.into(),
+            inv: inv.into(),
             t_max,
             general: inv.is_finite() && d.cmpne(Vec3::ZERO).all(),
         }
@@ -39,9 +39,8 @@ impl Slabs {
         if !self.general {
             return self.hits_scalar(n);
         }
-        let (o, inv) = (Vec3A::from(self.o), Vec3A::from(self.inv));
-        let a = (Vec3A::from(n.min) - o) * inv;
-        let b = (Vec3A::from(n.max) - o) * inv;
+        let a = (Vec3A::from(n.min) - self.o) * self.inv;
+        let b = (Vec3A::from(n.max) - self.o) * self.inv;
         let t0 = a.min(b).max_element().max(0.0);
         let t1 = a.max(b).min_element().min(self.t_max);
         t0 <= t1
