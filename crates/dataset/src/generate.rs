@@ -129,13 +129,17 @@ pub fn generate(
         crate::body_faces::write(&body_faces_path(out), &template_body.mesh.faces)?;
         manifest.body_faces = Some(file_entry(out, layout::BODY_FACES)?);
     }
+    let mut drape_options = spec.spec.simulator.drape_options().expect("validated");
+    // Every thread of the workers' pool runs a drape of its own: a solve split over two
+    // threads would only walk its factor twice (the drapes are the same either way).
+    drape_options.cloth.split_solve = false;
     let maker = Maker {
         model,
         template_body,
         spec: &spec.spec,
         plan: &plan,
         library: &library,
-        drape_options: spec.spec.simulator.drape_options().expect("validated"),
+        drape_options,
         templates: TemplateStore::new(out, plan.garments.len() + 2 * jobs + 2),
         bodies: KeyedCache::new(2 * jobs + 4),
         morphs: KeyedCache::new(2 * jobs + 2),

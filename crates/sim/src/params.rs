@@ -48,6 +48,13 @@ pub struct ClothParams {
     /// Chebyshev acceleration of the iterations: an estimate of their spectral radius in
     /// `[0, 1)` (Wang 2015); 0 turns it off. Too high a value makes the iterations oscillate.
     pub chebyshev_rho: f32,
+    /// Whether a global step solves x and y on one thread while z is solved on another
+    /// (`rayon::join`). The drape is the same to the bit either way: faer solves each
+    /// column alone. Splitting makes a lone drape faster (`garnet bench sim`, medians: 1.27
+    /// against 1.44 s at 2.5 cm), but it walks the factor twice, which costs more than it
+    /// gains where other drapes keep every thread busy (the dataset's workers: 27.3 against
+    /// 31.8 s of CPU for 18 drapes on two jobs; README "Simulator", session 42).
+    pub split_solve: bool,
 }
 
 impl Default for ClothParams {
@@ -68,6 +75,7 @@ impl Default for ClothParams {
             dt: 1.0 / 60.0,
             iterations: 8,
             chebyshev_rho: 0.95,
+            split_solve: true,
         }
     }
 }

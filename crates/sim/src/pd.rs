@@ -91,6 +91,8 @@ pub(crate) struct PdProblem<'a> {
     pub thick: f64,
     /// Friction coefficient.
     pub mu: f64,
+    /// Solve x and y beside z on two threads ([`crate::ClothParams::split_solve`]).
+    pub split_solve: bool,
 }
 
 impl PdProblem<'_> {
@@ -168,14 +170,17 @@ impl PdProblem<'_> {
                         *z = r.z;
                     });
             }
-            // x and y on one thread, z on another: faer's solve is sequential.
-            let (xy, z) = buf.split_at_mut(2 * nf);
-            let (a, b) = rayon::join(
-                || solver.solve_in_place(xy, 2),
-                || solver.solve_in_place(z, 1),
-            );
-            a?;
-            b?;
+            if self.split_solve {
+                let (xy, z) = buf.split_at_mut(2 * nf);
+                let (a, b) = rayon::join(
+                    || solver.solve_in_place(xy, 2),
+                    || solver.solve_in_place(z, 1),
+                );
+                a?;
+                b?;
+            } else {
+                solver.solve_in_place(&mut buf, 3)?;
+            }
             if rho > 0.0 {
                 omega = match it {
                     _ if it < DELAY => 1.0,

@@ -142,6 +142,7 @@ impl ClothSim {
                 active: &active,
                 thick: thick as f64,
                 mu: p.friction as f64,
+                split_solve: p.split_solve,
             };
             let change = problem.iterate(solver, p.iterations, p.chebyshev_rho as f64, &mut xs)?;
             info.iterations = p.iterations;
