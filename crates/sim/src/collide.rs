@@ -50,10 +50,11 @@ pub struct BodyCollider {
     edge_faces: Vec<[u32; 2]>,
     /// `[F]` unit face normals at `cur`.
     face_normals: Vec<Vec3>,
-    /// `[E]` edge pseudo-normals at `cur` (sum of the two face normals, normalised).
-    edge_normals: Vec<Vec3>,
-    /// `[N]` angle-weighted vertex pseudo-normals at `cur`.
-    vertex_pseudo: Vec<Vec3>,
+    /// `[N+1]` starts of each vertex's corners in `corners`.
+    corner_starts: Vec<u32>,
+    /// `[3F]` the corners (`3 * face + k`) at each vertex, faces ascending: the order in
+    /// which a pass over every face would add up the vertex's pseudo-normal.
+    corners: Vec<u32>,
     /// `[N]` area-weighted smooth vertex normals at `cur` (contact planes).
     vertex_normals: Vec<Vec3>,
     /// Largest vertex displacement from `prev` to `cur`, metres.
@@ -127,6 +128,7 @@ impl BodyCollider {
             ));
         }
         let bvh = Bvh::from_mesh(body)?;
+        let (corner_starts, corners) = corners_by_vertex(body.vertices.len(), &body.faces);
         let mut c = BodyCollider {
             faces: body.faces.clone(),
             prev: body.vertices.clone(),
@@ -137,8 +139,8 @@ impl BodyCollider {
             face_edges: topo.face_edges,
             edge_faces,
             face_normals: Vec::new(),
-            edge_normals: Vec::new(),
-            vertex_pseudo: Vec::new(),
+            corner_starts,
+            corners,
             vertex_normals: Vec::new(),
             max_disp: 0.0,
             prev_state: 0,
@@ -363,11 +365,12 @@ impl BodyCollider {
             let k = (0..3)
                 .max_by(|&a, &b| bary[a].total_cmp(&bary[b]))
                 .unwrap_or(0);
-            self.vertex_pseudo[f[k] as usize]
+            self.vertex_pseudo_normal(f[k] as usize)
         } else if zeros == 1 {
             let k = (0..3).find(|&k| bary[k] < EPS).unwrap_or(0);
             // The edge opposite corner k runs (k+1) -> (k+2): slot (k+1) % 3.
-            self.edge_normals[self.face_edges[face as usize][(k + 1) % 3] as usize]
+            let [g, h] = self.edge_faces[self.face_edges[face as usize][(k + 1) % 3] as usize];
+            (self.face_normals[g as usize] + self.face_normals[h as usize]).normalize_or_zero()
         } else {
             self.face_normals[face as usize]
         }
@@ -445,37 +448,56 @@ impl BodyCollider {
         best.map(|(t, dir)| (p + dir * (t + margin), dir))
     }
 
+    /// The face and smooth vertex normals at `cur`. The edge and vertex pseudo-normals are
+    /// worked out where a query needs one: a step asks for a few hundred of them, and a
+    /// pass over every face for all of them was about 4% of a dataset drape (session 42).
     fn update_normals(&mut self) {
-        let v = &self.cur;
-        let faces = &self.faces;
-        let n = v.len();
-        self.face_normals = geom::normals::face_normals(v, faces);
-        self.vertex_normals = geom::normals::vertex_normals(v, faces);
-        self.edge_normals = self
-            .edge_faces
-            .iter()
-            .map(|&[f, g]| {
-                (self.face_normals[f as usize] + self.face_normals[g as usize]).normalize_or_zero()
-            })
-            .collect();
-        let mut pseudo = vec![Vec3::ZERO; n];
-        for (fi, f) in faces.iter().enumerate() {
-            let fnorm = self.face_normals[fi];
-            for k in 0..3 {
-                let a = v[f[k] as usize];
-                let b = v[f[(k + 1) % 3] as usize];
-                let c = v[f[(k + 2) % 3] as usize];
-                let angle = (b - a).angle_between(c - a);
-                if angle.is_finite() {
-                    pseudo[f[k] as usize] += fnorm * angle;
-                }
+        self.face_normals = geom::normals::face_normals(&self.cur, &self.faces);
+        self.vertex_normals = geom::normals::vertex_normals(&self.cur, &self.faces);
+    }
+
+    /// The angle-weighted pseudo-normal of vertex `v` at `cur` (unit, or zero where its
+    /// corners are degenerate): each face's normal weighted by its angle at `v`, added up in
+    /// face order.
+    fn vertex_pseudo_normal(&self, v: usize) -> Vec3 {
+        let span = self.corner_starts[v] as usize..self.corner_starts[v + 1] as usize;
+        let mut sum = Vec3::ZERO;
+        for &corner in &self.corners[span] {
+            let (fi, k) = (corner as usize / 3, corner as usize % 3);
+            let f = self.faces[fi];
+            let a = self.cur[f[k] as usize];
+            let b = self.cur[f[(k + 1) % 3] as usize];
+            let c = self.cur[f[(k + 2) % 3] as usize];
+            let angle = (b - a).angle_between(c - a);
+            if angle.is_finite() {
+                sum += self.face_normals[fi] * angle;
             }
         }
-        for p in &mut pseudo {
-            *p = p.normalize_or_zero();
-        }
-        self.vertex_pseudo = pseudo;
+        sum.normalize_or_zero()
     }
+}
+
+/// The corners (`3 * face + k`) of `faces` (`[F]`) at each of `n` vertices, faces
+/// ascending: `([n+1]` starts, `[3F]` corners`)`.
+fn corners_by_vertex(n: usize, faces: &[[u32; 3]]) -> (Vec<u32>, Vec<u32>) {
+    let mut starts = vec![0u32; n + 1];
+    for f in faces {
+        for &v in f {
+            starts[v as usize + 1] += 1;
+        }
+    }
+    for i in 0..n {
+        starts[i + 1] += starts[i];
+    }
+    let mut fill = starts.clone();
+    let mut corners = vec![0u32; 3 * faces.len()];
+    for (fi, f) in faces.iter().enumerate() {
+        for (k, &v) in f.iter().enumerate() {
+            corners[fill[v as usize] as usize] = (3 * fi + k) as u32;
+            fill[v as usize] += 1;
+        }
+    }
+    (starts, corners)
 }
 
 #[cfg(test)]
@@ -503,6 +525,39 @@ mod tests {
                 assert_eq!(h.signed < 0.0, c.bvh_cur.contains(p), "{p} {}", h.signed);
                 assert!(h.out.dot(v) > 0.9);
             }
+        }
+    }
+
+    #[test]
+    fn pseudo_normals_on_demand_match_a_pass_over_every_face() {
+        let mut s = TriMesh::icosphere(3, 0.3);
+        for (i, v) in s.vertices.iter_mut().enumerate() {
+            *v *= 1.0 + 0.05 * ((i * 37 % 11) as f32 / 10.0 - 0.5);
+        }
+        let mut c = BodyCollider::new(&s, 0.004).unwrap();
+        let moved: Vec<Vec3> = s.vertices.iter().map(|v| *v * 1.1).collect();
+        c.move_to(&moved).unwrap();
+        // The plain way: every face adds its angle-weighted normal to its three corners.
+        let mut plain = vec![Vec3::ZERO; moved.len()];
+        for (fi, f) in s.faces.iter().enumerate() {
+            let n = c.face_normals[fi];
+            for k in 0..3 {
+                let a = moved[f[k] as usize];
+                let b = moved[f[(k + 1) % 3] as usize];
+                let cc = moved[f[(k + 2) % 3] as usize];
+                let angle = (b - a).angle_between(cc - a);
+                if angle.is_finite() {
+                    plain[f[k] as usize] += n * angle;
+                }
+            }
+        }
+        for (v, p) in plain.iter().enumerate() {
+            assert_eq!(
+                c.vertex_pseudo_normal(v),
+                p.normalize_or_zero(),
+                "vertex {v}"
+            );
+            assert!(c.vertex_pseudo_normal(v).dot(moved[v]) > 0.0, "vertex {v}");
         }
     }
 
