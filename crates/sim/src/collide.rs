@@ -14,7 +14,7 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use geom::adjacency::{EdgeTopology, NO_EDGE};
+use geom::adjacency::{Csr, EdgeTopology, NO_EDGE};
 use geom::{Bvh, ClosestHit, TriMesh};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -50,11 +50,9 @@ pub struct BodyCollider {
     edge_faces: Vec<[u32; 2]>,
     /// `[F]` unit face normals at `cur`.
     face_normals: Vec<Vec3>,
-    /// `[N+1]` starts of each vertex's corners in `corners`.
-    corner_starts: Vec<u32>,
-    /// `[3F]` the corners (`3 * face + k`) at each vertex, faces ascending: the order in
-    /// which a pass over every face would add up the vertex's pseudo-normal.
-    corners: Vec<u32>,
+    /// `[N]` rows: the faces at each vertex, ascending (the order in which a pass over every
+    /// face would add up the vertex's pseudo-normal).
+    vertex_faces: Csr,
     /// `[N]` area-weighted smooth vertex normals at `cur` (contact planes).
     vertex_normals: Vec<Vec3>,
     /// Largest vertex displacement from `prev` to `cur`, metres.
@@ -128,7 +126,7 @@ impl BodyCollider {
             ));
         }
         let bvh = Bvh::from_mesh(body)?;
-        let (corner_starts, corners) = corners_by_vertex(body.vertices.len(), &body.faces);
+        let vertex_faces = geom::adjacency::vertex_faces(body.vertices.len(), &body.faces)?;
         let mut c = BodyCollider {
             faces: body.faces.clone(),
             prev: body.vertices.clone(),
@@ -139,8 +137,7 @@ impl BodyCollider {
             face_edges: topo.face_edges,
             edge_faces,
             face_normals: Vec::new(),
-            corner_starts,
-            corners,
+            vertex_faces,
             vertex_normals: Vec::new(),
             max_disp: 0.0,
             prev_state: 0,
@@ -460,11 +457,12 @@ impl BodyCollider {
     /// corners are degenerate): each face's normal weighted by its angle at `v`, added up in
     /// face order.
     fn vertex_pseudo_normal(&self, v: usize) -> Vec3 {
-        let span = self.corner_starts[v] as usize..self.corner_starts[v + 1] as usize;
         let mut sum = Vec3::ZERO;
-        for &corner in &self.corners[span] {
-            let (fi, k) = (corner as usize / 3, corner as usize % 3);
+        for &fi in self.vertex_faces.row(v) {
+            let fi = fi as usize;
             let f = self.faces[fi];
+            // No face repeats a vertex (`new` refuses degenerate faces): one corner at `v`.
+            let k = f.iter().position(|&w| w as usize == v).unwrap_or(0);
             let a = self.cur[f[k] as usize];
             let b = self.cur[f[(k + 1) % 3] as usize];
             let c = self.cur[f[(k + 2) % 3] as usize];
@@ -475,29 +473,6 @@ impl BodyCollider {
         }
         sum.normalize_or_zero()
     }
-}
-
-/// The corners (`3 * face + k`) of `faces` (`[F]`) at each of `n` vertices, faces
-/// ascending: `([n+1]` starts, `[3F]` corners`)`.
-fn corners_by_vertex(n: usize, faces: &[[u32; 3]]) -> (Vec<u32>, Vec<u32>) {
-    let mut starts = vec![0u32; n + 1];
-    for f in faces {
-        for &v in f {
-            starts[v as usize + 1] += 1;
-        }
-    }
-    for i in 0..n {
-        starts[i + 1] += starts[i];
-    }
-    let mut fill = starts.clone();
-    let mut corners = vec![0u32; 3 * faces.len()];
-    for (fi, f) in faces.iter().enumerate() {
-        for (k, &v) in f.iter().enumerate() {
-            corners[fill[v as usize] as usize] = (3 * fi + k) as u32;
-            fill[v as usize] += 1;
-        }
-    }
-    (starts, corners)
 }
 
 #[cfg(test)]
