@@ -152,10 +152,10 @@ fn max_pool_rows(table: &Tensor<2>, knn: &[Tensor<1, Int>]) -> Result<Tensor<2>>
             if c == 0 {
                 dst.copy_from_slice(src);
             } else {
+                // A select, not a conditional store: it compiles to vector compares and
+                // blends (the `if v > *a { *a = v }` form was branchy scalar code).
                 for (a, &v) in dst.iter_mut().zip(src) {
-                    if v > *a {
-                        *a = v;
-                    }
+                    *a = if v > *a { v } else { *a };
                 }
             }
         }

@@ -14,13 +14,8 @@ use burn::module::Param;
 use burn::nn::Linear;
 use burn::prelude::*;
 
-use std::mem::MaybeUninit;
-
-use rayon::prelude::*;
-
-use crate::error::Result;
 use crate::init::ParamInit;
-use crate::tensors::{gather_rows, read_f32, read_i64, untracked_on_flex, vec_tensor};
+use crate::tensors::gather_rows;
 
 /// Largest span of a batch's assignment logits (over the heads of one vertex, plus the
 /// span of the offsets) for which the factored assignment is used: its factors stay above
@@ -73,12 +68,7 @@ impl FeaStConv {
         ring_weight: &Tensor<4>,
     ) -> Tensor<3> {
         let q = self.assignment(x.clone(), ring, ring_weight); // [B,N,K,M]
-        let agg = if untracked_on_flex(&x) && untracked_on_flex(&q) {
-            aggregate_rows(&x, ring, &q).unwrap_or_else(|_| aggregate_tensors(x, ring, q))
-        } else {
-            aggregate_tensors(x, ring, q)
-        };
-        self.w.forward(agg)
+        self.w.forward(aggregate_tensors(x, ring, q))
     }
 
     /// The soft assignments times the neighbourhood weights, `w_ij q_m(x_i, x_j)`:
@@ -126,8 +116,9 @@ impl FeaStConv {
 /// The per-head aggregation `a_i[f, m] = sum_k q_ikm x_{ring(i,k)}[f]` with burn's ops:
 /// `x` `[B,N,d_in]`, `ring` `[N*K]`, `q` `[B,N,K,M]` -> `[B,N,d_in*M]` (entry `f*M + m`), as
 /// `[d_in,K] x [K,M]` per vertex (this orientation runs ~2.5x faster on flex than
-/// `[M,K] x [K,d_in]`). Used whenever gradients flow, and on the GPU backends.
-fn aggregate_tensors(x: Tensor<3>, ring: &Tensor<1, Int>, q: Tensor<4>) -> Tensor<3> {
+/// `[M,K] x [K,d_in]`). Drapes and evaluation on the CPU take the plain loops of
+/// [`crate::feast_rows`] instead.
+pub(crate) fn aggregate_tensors(x: Tensor<3>, ring: &Tensor<1, Int>, q: Tensor<4>) -> Tensor<3> {
     let [b, n, d_in] = x.dims();
     let [_, _, k, m] = q.dims();
     let x_j = gather_rows(x, ring).reshape([b * n, k, d_in]);
@@ -135,52 +126,10 @@ fn aggregate_tensors(x: Tensor<3>, ring: &Tensor<1, Int>, q: Tensor<4>) -> Tenso
     x_j.swap_dims(1, 2).matmul(q).reshape([b, n, d_in * m]) // [B*N,d_in,M]
 }
 
-/// [`aggregate_tensors`] as plain loops over the vertices (in parallel), for untracked
-/// tensors on the CPU: the same `[B,N,d_in*M]` values (summed over the neighbours in ring
-/// order, so equal to the products' within rounding). Written by hand because flex allocates every matrix product's output zeroed
-/// and then copies it once more to align it: on a 10k-vertex garment that was ~16% of a
-/// GarNet-Local drape, with hardly any arithmetic (`perf`, docs/model.md "Speed").
-fn aggregate_rows(x: &Tensor<3>, ring: &Tensor<1, Int>, q: &Tensor<4>) -> Result<Tensor<3>> {
-    let [b, n, d_in] = x.dims();
-    let [_, _, k, m] = q.dims();
-    let xs = read_f32(x.clone())?;
-    let qs = read_f32(q.clone())?;
-    let ring = read_i64(ring.clone())?;
-    let width = d_in * m;
-    let len = b * n * width;
-    if len == 0 {
-        return Ok(vec_tensor(Vec::new(), [b, n, width], &x.device()));
-    }
-    let mut out: Vec<f32> = Vec::with_capacity(len);
-    out.spare_capacity_mut()[..len]
-        .par_chunks_mut(width)
-        .enumerate()
-        .for_each(|(row, dst)| {
-            for e in dst.iter_mut() {
-                e.write(0.0);
-            }
-            // SAFETY: every element of `dst` was initialised just above.
-            let dst = unsafe { &mut *(dst as *mut [MaybeUninit<f32>] as *mut [f32]) };
-            let sample = row / n;
-            for slot in 0..k {
-                let j = ring[(row % n) * k + slot] as usize;
-                let x_j = &xs[(sample * n + j) * d_in..][..d_in];
-                let q_j = &qs[(row * k + slot) * m..][..m];
-                for (a, &xf) in dst.chunks_exact_mut(m).zip(x_j) {
-                    for (a, &qm) in a.iter_mut().zip(q_j) {
-                        *a += xf * qm;
-                    }
-                }
-            }
-        });
-    // SAFETY: the chunks above initialised all `len` elements.
-    unsafe { out.set_len(len) };
-    Ok(vec_tensor(out, [b, n, width], &x.device()))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::tensors::{read_f32, vec_tensor};
     use crate::topology::GarmentTopology;
     use rand::{Rng, SeedableRng};
 
@@ -282,36 +231,6 @@ mod tests {
                 .fold(0.0, f64::max);
             assert!(worst < 5e-5, "range {range}: largest difference {worst}");
         }
-    }
-
-    /// The loops of `aggregate_rows` (drapes, evaluation) against burn's products of
-    /// `aggregate_tensors` (training), on a batch of two samples with padded rings.
-    #[test]
-    fn aggregation_loops_match_the_tensor_products() {
-        let device = Device::flex();
-        let mesh = geom::TriMesh::grid(6, 5, 0.1);
-        let topo = GarmentTopology::from_mesh(&mesh).unwrap();
-        let tt = topo.to_device(&device);
-        let (b, n, d_in, m) = (2, mesh.num_vertices(), 7, 4);
-        let k = tt.ring_weight.dims()[2];
-        let mut rng = rand::rngs::StdRng::seed_from_u64(5);
-        let mut random =
-            |len: usize| -> Vec<f32> { (0..len).map(|_| rng.random_range(-1.0..1.0)).collect() };
-        let x = vec_tensor(random(b * n * d_in), [b, n, d_in], &device);
-        let q = vec_tensor(random(b * n * k * m), [b, n, k, m], &device);
-        assert!(untracked_on_flex(&x) && untracked_on_flex(&q));
-        let loops = aggregate_rows(&x, &tt.ring, &q).unwrap();
-        let products = aggregate_tensors(x, &tt.ring, q);
-        assert_eq!(loops.dims(), [b, n, d_in * m]);
-        assert_eq!(products.dims(), [b, n, d_in * m]);
-        let (loops, products) = (read_f32(loops).unwrap(), read_f32(products).unwrap());
-        let worst = loops
-            .iter()
-            .zip(&products)
-            .map(|(a, p)| (a - p).abs())
-            .fold(0.0f32, f32::max);
-        assert!(worst < 1e-5, "largest difference {worst}");
-        assert!(loops.iter().any(|v| v.abs() > 0.1), "not all zero");
     }
 
     #[test]

@@ -12,10 +12,13 @@ use burn::prelude::*;
 
 use crate::config::GarNetConfig;
 use crate::contact::CONTACT_WIDTH;
+use crate::error::Result;
 use crate::feast::FeaStConv;
+use crate::feast_rows::Epilogue;
 use crate::init::ParamInit;
 use crate::layers::{lrelu, max_points, CondLinear};
 use crate::stn::Stn;
+use crate::tensors::{read_f32, untracked_on_flex, vec_tensor};
 use crate::topology::TopologyTensors;
 
 /// `conv` over the garment's 1-ring applied to the features `x` `[B,N,C]` concatenated with
@@ -27,6 +30,29 @@ fn conv_with_positions(
     topo: &TopologyTensors,
 ) -> Tensor<3> {
     conv.forward(Tensor::cat(vec![x, pos], 2), &topo.ring, &topo.ring_weight)
+}
+
+/// The block `run` computes as plain loops on the host (drapes and evaluation: untracked
+/// tensors on flex, see [`crate::feast_rows`]): `run(x, pos, N)` gets `x` `[B*N*C]` and `pos`
+/// `[B*N*3]` row-major and returns `[B*N*C]`, or `None` to leave it to the tensor path
+/// (as do tracked tensors, other backends and any error).
+fn block_rows(
+    x: &Tensor<3>,
+    pos: &Tensor<3>,
+    topo: &TopologyTensors,
+    run: impl FnOnce(&[f32], &[f32], usize) -> Result<Option<Vec<f32>>>,
+) -> Option<Tensor<3>> {
+    if !(untracked_on_flex(x) && untracked_on_flex(pos)) {
+        return None;
+    }
+    let [b, n, c] = x.dims();
+    if topo.n_vertices != n {
+        return None;
+    }
+    let xs = read_f32(x.clone()).ok()?;
+    let ps = read_f32(pos.clone()).ok()?;
+    let y = run(&xs, &ps, n).ok()??;
+    Some(vec_tensor(y, [b, n, c], &x.device()))
 }
 
 /// A residual block of FeaStNet convolutions `C+3 -> C`, each seeing the features
@@ -56,6 +82,9 @@ impl ResBlock {
 
     /// `x` `[B,N,C]`, `pos` `[B,N,3]` -> `[B,N,C]`.
     pub fn forward(&self, x: Tensor<3>, pos: Tensor<3>, topo: &TopologyTensors) -> Tensor<3> {
+        if let Some(y) = self.forward_host(&x, &pos, topo) {
+            return y;
+        }
         let mut h = x.clone();
         for (i, conv) in self.convs.iter().enumerate() {
             if i > 0 {
@@ -64,6 +93,31 @@ impl ResBlock {
             h = conv_with_positions(conv, h, pos.clone(), topo);
         }
         lrelu(x + h)
+    }
+
+    /// [`ResBlock::forward`] as plain loops ([`block_rows`]), or `None`.
+    fn forward_host(
+        &self,
+        x: &Tensor<3>,
+        pos: &Tensor<3>,
+        topo: &TopologyTensors,
+    ) -> Option<Tensor<3>> {
+        block_rows(x, pos, topo, |xs, ps, n| {
+            let mut h: Option<Vec<f32>> = None;
+            for (i, conv) in self.convs.iter().enumerate() {
+                let epilogue = if i + 1 == self.convs.len() {
+                    Epilogue::ResidualLrelu(xs)
+                } else {
+                    Epilogue::Lrelu
+                };
+                let input = h.as_deref().unwrap_or(xs);
+                match conv.forward_rows(input, ps, n, &topo.host_ring, epilogue)? {
+                    Some(y) => h = Some(y),
+                    None => return Ok(None),
+                }
+            }
+            Ok(h)
+        })
     }
 }
 
@@ -98,7 +152,23 @@ impl ExtraBlock {
 
     /// `x` `[B,N,C]`, `pos` `[B,N,3]` -> `[B,N,C]`.
     pub fn forward(&self, x: Tensor<3>, pos: Tensor<3>, topo: &TopologyTensors) -> Tensor<3> {
+        if let Some(y) = self.forward_host(&x, &pos, topo) {
+            return y;
+        }
         x.clone() + conv_with_positions(&self.conv, x, pos, topo)
+    }
+
+    /// [`ExtraBlock::forward`] as plain loops ([`block_rows`]), or `None`.
+    fn forward_host(
+        &self,
+        x: &Tensor<3>,
+        pos: &Tensor<3>,
+        topo: &TopologyTensors,
+    ) -> Option<Tensor<3>> {
+        block_rows(x, pos, topo, |xs, ps, n| {
+            self.conv
+                .forward_rows(xs, ps, n, &topo.host_ring, Epilogue::Residual(xs))
+        })
     }
 }
 
@@ -218,5 +288,55 @@ impl GarmentStream {
             patches,
             global,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::topology::GarmentTopology;
+    use rand::{Rng, SeedableRng};
+
+    /// The blocks' plain loops (untracked tensors on flex) against the same blocks written
+    /// with burn's ops: residual blocks of one and two convolutions, and an extra block.
+    #[test]
+    fn blocks_on_the_host_match_the_tensor_ops() {
+        let device = Device::flex();
+        let mesh = geom::TriMesh::grid(12, 9, 0.1);
+        let topo = GarmentTopology::from_mesh(&mesh)
+            .unwrap()
+            .to_device(&device);
+        let (b, n, c) = (2, mesh.num_vertices(), 6);
+        let mut rng = rand::rngs::StdRng::seed_from_u64(2);
+        let mut random =
+            |len: usize| -> Vec<f32> { (0..len).map(|_| rng.random_range(-1.0..1.0)).collect() };
+        let x = vec_tensor(random(b * n * c), [b, n, c], &device);
+        let pos = vec_tensor(random(b * n * 3), [b, n, 3], &device);
+        let conv = |f: &FeaStConv, h: Tensor<3>| conv_with_positions(f, h, pos.clone(), &topo);
+        let compare = |got: Tensor<3>, want: Tensor<3>, what: &str| {
+            let (got, want) = (read_f32(got).unwrap(), read_f32(want).unwrap());
+            let worst = got
+                .iter()
+                .zip(&want)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0f32, f32::max);
+            assert!(worst < 1e-5, "{what}: {worst}");
+        };
+        let mut init = ParamInit::new(4);
+        for convs in [1, 2] {
+            let block = ResBlock::new(c, convs, 8, &mut init, &device);
+            let mut h = conv(&block.convs[0], x.clone());
+            if convs == 2 {
+                h = conv(&block.convs[1], lrelu(h));
+            }
+            let want = lrelu(x.clone() + h);
+            let got = block.forward_host(&x, &pos, &topo).expect("the host path");
+            compare(got, want, "residual block");
+        }
+        let mut extra = ExtraBlock::new(c, 8, 1, 0, &device);
+        extra.conv.w = init.hidden(8 * (c + 3), c, &device);
+        let want = x.clone() + conv(&extra.conv, x.clone());
+        let got = extra.forward_host(&x, &pos, &topo).expect("the host path");
+        compare(got, want, "extra block");
     }
 }

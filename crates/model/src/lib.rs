@@ -44,6 +44,7 @@ pub mod contact;
 pub mod drape;
 pub mod error;
 pub mod feast;
+pub mod feast_rows;
 pub mod frame;
 pub mod fusion;
 pub mod garment_stream;

@@ -2,9 +2,12 @@
 //! normal loss), the padded 1-ring table (for the FeaStNet convolutions) and the two-ring
 //! pairs (for the bending loss).
 
+use std::sync::Arc;
+
 use burn::prelude::*;
 
 use crate::error::{ModelError, Result};
+use crate::feast_rows::HostRing;
 use crate::tensors::{index_tensor, vec_tensor};
 
 /// Garment connectivity on the CPU.
@@ -79,6 +82,11 @@ impl GarmentTopology {
             n_faces: self.faces.len(),
             n_bend_pairs: self.bend_pairs.len(),
             ring: index_tensor(self.ring.iter().map(|&i| i as i64), device),
+            host_ring: Arc::new(HostRing {
+                ring: self.ring.clone(),
+                weight: self.ring_weight.clone(),
+                k,
+            }),
             ring_weight: vec_tensor(self.ring_weight.clone(), [1, n, k, 1], device),
             faces: [face_col(0), face_col(1), face_col(2)],
             bend_pairs: [pair_col(0), pair_col(1)],
@@ -101,6 +109,8 @@ pub struct TopologyTensors {
     pub ring: Tensor<1, Int>,
     /// `[1,N,K,1]` neighbourhood weights.
     pub ring_weight: Tensor<4>,
+    /// The same neighbourhoods on the host, for the CPU's plain-loop convolutions.
+    pub host_ring: Arc<HostRing>,
     /// Face corners: three `[F]` index tensors (first, second, third vertex of each face).
     pub faces: [Tensor<1, Int>; 3],
     /// Bending pairs: two `[P]` index tensors.
