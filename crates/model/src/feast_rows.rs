@@ -97,11 +97,14 @@ impl FeaStConv {
             Some(b) => read_f32(b.val())?,
             None => vec![0.0; d_out],
         };
-        let xin: Vec<f32> = x
-            .par_chunks(c.max(1))
+        let mut xin = vec![0.0f32; rows * d_in];
+        xin.par_chunks_mut(d_in)
             .zip(pos.par_chunks(3))
-            .flat_map_iter(|(x, p)| x[..c].iter().chain(p).copied())
-            .collect();
+            .enumerate()
+            .for_each(|(r, (row, p))| {
+                row[..c].copy_from_slice(&x[r * c..][..c]);
+                row[c..].copy_from_slice(p);
+            });
         let Some((e, f)) = factors(&xin, d_in, &u, &offsets) else {
             return Ok(None);
         };
@@ -137,31 +140,7 @@ impl FeaStConv {
                 for row in dst.chunks_exact_mut(d_out) {
                     row.copy_from_slice(&bias);
                 }
-                // SAFETY: row-major `dst` [tile_rows, d_out], `agg` [tile_rows, width] and
-                // `weight` [width, d_out], each as long as its shape says.
-                unsafe {
-                    gemm::gemm(
-                        tile_rows,
-                        d_out,
-                        width,
-                        dst.as_mut_ptr(),
-                        1,
-                        d_out as isize,
-                        true,
-                        agg.as_ptr(),
-                        1,
-                        width as isize,
-                        weight.as_ptr(),
-                        1,
-                        d_out as isize,
-                        1.0,
-                        1.0,
-                        false,
-                        false,
-                        false,
-                        gemm::Parallelism::None,
-                    );
-                }
+                add_product(dst, &agg, &weight, width);
                 epilogue.apply(tile * TILE * d_out, dst);
             });
         Ok(Some(out))
@@ -174,12 +153,10 @@ impl FeaStConv {
 /// when the logits span [`FACTORED_SPAN`] or more, or are not finite.
 fn factors(xin: &[f32], d_in: usize, u: &[f32], c: &[f32]) -> Option<(Vec<f32>, Vec<f32>)> {
     let m = c.len();
-    let a: Vec<f32> = xin
-        .par_chunks(d_in)
-        .flat_map_iter(|row| {
-            (0..m).map(move |h| row.iter().enumerate().map(|(f, &v)| v * u[f * m + h]).sum())
-        })
-        .collect();
+    let mut a = vec![0.0f32; xin.len() / d_in * m];
+    a.par_chunks_mut(TILE * m)
+        .zip(xin.par_chunks(TILE * d_in))
+        .for_each(|(a, x)| add_product(a, x, u, d_in));
     let spread = |v: &[f32]| {
         let (lo, hi) = v
             .iter()
@@ -211,6 +188,41 @@ fn factors(xin: &[f32], d_in: usize, u: &[f32], c: &[f32]) -> Option<(Vec<f32>, 
         }
     }
     Some((e, f))
+}
+
+/// `dst` `[R, n] += src [R, k] x weight [k, n]`, all row-major (n from `weight`'s length),
+/// by `gemm` on this thread.
+fn add_product(dst: &mut [f32], src: &[f32], weight: &[f32], k: usize) {
+    let n = weight.len() / k.max(1);
+    let rows = dst.len() / n.max(1);
+    if rows == 0 || n == 0 || k == 0 || src.len() != rows * k || weight.len() != k * n {
+        return;
+    }
+    // SAFETY: `dst` [rows, n], `src` [rows, k] and `weight` [k, n] hold exactly their shapes
+    // (checked above), row-major.
+    unsafe {
+        gemm::gemm(
+            rows,
+            n,
+            k,
+            dst.as_mut_ptr(),
+            1,
+            n as isize,
+            true,
+            src.as_ptr(),
+            1,
+            k as isize,
+            weight.as_ptr(),
+            1,
+            n as isize,
+            1.0,
+            1.0,
+            false,
+            false,
+            false,
+            gemm::Parallelism::None,
+        );
+    }
 }
 
 /// Whether this CPU runs AVX2 with fused multiply-adds (checked once, then cached by std).
@@ -286,9 +298,14 @@ impl Aggregation<'_> {
             let col = sample * n + j as usize;
             let e_j = &self.e[col * m..][..m];
             let start = scratch.q.len();
-            scratch.q.extend(e_j.iter().zip(f_i).map(|(e, f)| e * f));
+            scratch.q.resize(start + m, 0.0);
             let q = &mut scratch.q[start..];
-            let scale = w / (q.iter().sum::<f32>() + f32::MIN_POSITIVE);
+            let mut sum = 0.0f32;
+            for ((q, e), f) in q.iter_mut().zip(e_j).zip(f_i) {
+                *q = e * f;
+                sum += *q;
+            }
+            let scale = w / (sum + f32::MIN_POSITIVE);
             q.iter_mut().for_each(|v| *v *= scale);
             scratch.starts.push(col * self.d_in);
         }
