@@ -1,6 +1,6 @@
 //! Which body points the network sees, and GarNet-Local's neighbour tables (computed on the
-//! CPU, among the stream points with a k-d tree, kiddo through [`geom::KnnIndex`], among the
-//! few hundred kept points by a scan, and passed to the network as int tensors).
+//! CPU with k-d trees, kiddo through [`geom::KnnIndex`], and passed to the network as int
+//! tensors).
 //!
 //! The bodies of a dataset share one topology (13380 vertices here, against SMPL's 6890 in the
 //! paper), so the subsampling is a fixed list of body vertices ([`BodySampling`]), chosen once
@@ -127,52 +127,9 @@ impl BodySampling {
         let index = geom::KnnIndex::new(stream)?;
         let centres = &stream[..self.n_centres];
         let pool = index.query(centres, pool_k)?.indices;
-        check_finite("warped garment M", warped)?;
-        let knn = nearest_by_scan(centres, warped, knn_k);
+        let knn = geom::knn::knn(centres, warped, knn_k)?.indices;
         Ok((pool, knn))
     }
-}
-
-/// The `k` nearest of `points` `[P]` (at least `k`) to each of `queries` `[Q]`, by
-/// comparing every pair: `[Q*k]` indices into `points`, nearest first, ties to the lower
-/// index (as [`geom::knn::knn_brute`]). For the few hundred kept points of the local
-/// pooling, a scan of their coordinates (vectorised) and an insertion into the k best is
-/// faster than a k-d tree: kiddo's search and its sorted result list were about an eighth
-/// of a 10k-vertex drape (`perf`, docs/model.md "Speed", session 43).
-fn nearest_by_scan(points: &[Vec3], queries: &[Vec3], k: usize) -> Vec<u32> {
-    use rayon::prelude::*;
-    let axis = |a: fn(&Vec3) -> f32| points.iter().map(a).collect::<Vec<f32>>();
-    let (xs, ys, zs) = (axis(|p| p.x), axis(|p| p.y), axis(|p| p.z));
-    let mut out = vec![0u32; queries.len() * k];
-    if k == 0 {
-        return out;
-    }
-    out.par_chunks_mut(k).zip(queries.par_iter()).for_each_init(
-        || (vec![0.0f32; points.len()], Vec::with_capacity(k + 1)),
-        |(d, best): &mut (Vec<f32>, Vec<(f32, u32)>), (row, q)| {
-            for (((d, &x), &y), &z) in d.iter_mut().zip(&xs).zip(&ys).zip(&zs) {
-                let (dx, dy, dz) = (x - q.x, y - q.y, z - q.z);
-                *d = dx * dx + dy * dy + dz * dz;
-            }
-            best.clear();
-            for (i, &di) in d.iter().enumerate() {
-                if best.len() == k && di >= best[k - 1].0 {
-                    continue;
-                }
-                // After every kept entry at most as far: ties keep the lower index first.
-                let at = best
-                    .iter()
-                    .rposition(|&(b, _)| b <= di)
-                    .map_or(0, |p| p + 1);
-                best.insert(at, (di, i as u32));
-                best.truncate(k);
-            }
-            for (o, &(_, i)) in row.iter_mut().zip(best.iter()) {
-                *o = i;
-            }
-        },
-    );
-    out
 }
 
 /// GarNet-Local's neighbour tables for a batch, as flat row indices into the batch-flattened
@@ -283,31 +240,6 @@ mod tests {
         let again = BodySampling::farthest_point(&body, 20, 1).unwrap();
         assert_eq!(again.stream[..], s.stream[..s.n_centres]);
         assert_eq!(kept.len(), 30);
-    }
-
-    /// The scan against the brute-force search of `geom` (same tie rule): the same indices
-    /// in the same order, for several k up to every point, equidistant points included.
-    #[test]
-    fn nearest_by_scan_matches_the_brute_force_search() {
-        let points: Vec<Vec3> = (0..57)
-            .map(|i| {
-                let t = i as f32;
-                // Coordinates on a coarse grid: many equal distances.
-                Vec3::new(
-                    (t * 0.7).sin().round(),
-                    (t * 1.3).cos().round(),
-                    (i % 5) as f32,
-                )
-            })
-            .collect();
-        let queries: Vec<Vec3> = (0..40)
-            .map(|i| Vec3::new(i as f32 * 0.1 - 2.0, (i % 7) as f32 * 0.5, 1.0))
-            .chain([Vec3::ZERO, Vec3::new(1.0, 1.0, 2.0)])
-            .collect();
-        for k in [1, 3, 15, 57] {
-            let want = geom::knn::knn_brute(&points, &queries, k).unwrap().indices;
-            assert_eq!(nearest_by_scan(&points, &queries, k), want, "k = {k}");
-        }
     }
 
     #[test]
