@@ -404,7 +404,7 @@ impl Aggregation<'_> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::feast::aggregate_tensors;
     use crate::init::ParamInit;
@@ -413,7 +413,8 @@ mod tests {
     use burn::prelude::*;
     use rand::{Rng, SeedableRng};
 
-    fn largest_difference(a: &[f32], b: &[f32]) -> f32 {
+    /// The largest absolute difference between two equally long value lists.
+    pub(crate) fn largest_difference(a: &[f32], b: &[f32]) -> f32 {
         assert_eq!(a.len(), b.len());
         a.iter()
             .zip(b)

@@ -294,6 +294,7 @@ impl GarmentStream {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::feast_rows::tests::largest_difference;
     use crate::topology::GarmentTopology;
     use rand::{Rng, SeedableRng};
 
@@ -315,11 +316,7 @@ mod tests {
         let conv = |f: &FeaStConv, h: Tensor<3>| conv_with_positions(f, h, pos.clone(), &topo);
         let compare = |got: Tensor<3>, want: Tensor<3>, what: &str| {
             let (got, want) = (read_f32(got).unwrap(), read_f32(want).unwrap());
-            let worst = got
-                .iter()
-                .zip(&want)
-                .map(|(a, b)| (a - b).abs())
-                .fold(0.0f32, f32::max);
+            let worst = largest_difference(&got, &want);
             assert!(worst < 1e-5, "{what}: {worst}");
         };
         let mut init = ParamInit::new(4);
