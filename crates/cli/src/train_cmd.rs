@@ -3,7 +3,7 @@
 //! and a metrics log (`metrics.csv`).
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context};
 use burn::module::Module;
@@ -59,9 +59,15 @@ pub struct TrainArgs {
     /// `runs/GARMENT-VARIANT`.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// Continue from `OUT/last.garnet` (network, optimiser and progress).
+    /// Continue from `OUT/last.garnet` (network, optimiser and progress), or from inside
+    /// an epoch where `OUT/mid-epoch.garnet` is further on (see --checkpoint-minutes).
     #[arg(long)]
     pub resume: bool,
+    /// Inside an epoch, write `OUT/mid-epoch.garnet` every this many minutes (0: never),
+    /// so that a run stopped inside a long epoch resumes there with --resume, on the same
+    /// training set, batch size and seed. Removed when the epoch ends.
+    #[arg(long, value_name = "MINUTES", default_value_t = 10.0)]
+    pub checkpoint_minutes: f64,
     /// Also keep every epoch's checkpoint as `OUT/epoch-N.garnet` (with the optimiser
     /// state, about 9 MB for GarNet-Local): snapshots for `garnet average`, or to branch a
     /// run from (copy one to another folder's `last.garnet` and `--resume` there).
@@ -183,18 +189,21 @@ impl<'a> GarmentSplit<'a> {
         Ok(self.data.sample(self.indices[0])?.arrays.body)
     }
 
-    /// Batches of the samples in `order`, converted to network samples (with targets).
+    /// Batches of the samples in `order` after the first `skip` (never read), converted to
+    /// network samples (with targets).
     pub fn batches(
         &self,
         batch_size: usize,
         order: Order,
+        skip: usize,
     ) -> impl Iterator<Item = Result<Vec<Sample>, String>> + '_ {
         let opts = BatchOptions {
             batch_size,
             order,
             drop_last: false,
         };
-        Batches::new(self.data, &self.indices, opts).map(move |b| {
+        let batches = Batches::new(self.data, &self.indices, opts).skip_batches(skip);
+        batches.map(move |b| {
             let b = b.map_err(|e| e.to_string())?;
             b.into_iter()
                 .map(|s| {
@@ -265,17 +274,33 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
         PathBuf::from("runs").join(format!("{}-{}", args.garment, variant.name()))
     });
     let device = args.device.device()?;
-    let last = out.join(model::trainer::LAST_CHECKPOINT);
-    let resumed = args.resume && last.is_file();
-    let mut trainer = if resumed {
-        eprintln!("resuming from {}", last.display());
-        let trainer = Trainer::resume(&last, Some(args.lr), &device)
-            .with_context(|| format!("resuming {}", last.display()))?;
-        check_body_skinning(trainer.setup(), &data, &last)?;
+    let checkpoint_every = checkpoint_interval(args.checkpoint_minutes)?;
+    let from = match args.resume {
+        true => Trainer::resume_point(&out)
+            .with_context(|| format!("choosing the checkpoint to resume in {}", out.display()))?,
+        false => None,
+    };
+    let resumed = from.is_some();
+    let mut trainer = if let Some(from) = &from {
+        let trainer = Trainer::resume(from, Some(args.lr), &device)
+            .with_context(|| format!("resuming {}", from.display()))?;
+        match &trainer.state().partial {
+            Some(p) => eprintln!(
+                "resuming from {} inside epoch {}, after {} batches",
+                from.display(),
+                trainer.state().epoch + 1,
+                p.batches
+            ),
+            None => eprintln!("resuming from {}", from.display()),
+        }
+        check_body_skinning(trainer.setup(), &data, from)?;
         trainer
     } else {
         if args.resume {
-            eprintln!("no {} yet: starting afresh", last.display());
+            eprintln!(
+                "no {} yet: starting afresh",
+                out.join(model::trainer::LAST_CHECKPOINT).display()
+            );
         }
         let template = train.template()?;
         let garment_file = template.to_bytes(&args.data)?;
@@ -340,6 +365,8 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
         .transpose()?;
     trainer.set_schedule(schedule);
     trainer.set_keep_epochs(args.keep_epochs);
+    trainer.set_checkpoint_every(checkpoint_every);
+    trainer.set_training_set(&training_set_name(&data, &train.indices, args));
     trainer.set_command(crate::output::command_line());
     let params = trainer.model().num_params();
     eprintln!(
@@ -372,9 +399,10 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
         .progress_chars("=> "),
     );
     let seed = args.seed;
-    let train_batches = |epoch: usize| {
+    let train_batches = |epoch: usize, skip: usize| {
         bar.set_prefix((epoch + 1).to_string());
         bar.reset();
+        bar.set_position(skip as u64);
         let bar = bar.clone();
         // Without a terminal (a log file) the bar is hidden: a line every few minutes.
         let mut log = LogLines::new(LOG_EVERY, "batches");
@@ -385,6 +413,7 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
                     seed,
                     epoch: epoch as u64,
                 },
+                skip,
             )
             .inspect(move |_| {
                 bar.inc(1);
@@ -398,7 +427,7 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
     };
     let valid_batches = valid
         .as_ref()
-        .map(|v| move || v.batches(args.batch, Order::InOrder));
+        .map(|v| move || v.batches(args.batch, Order::InOrder, 0));
     trainer.fit(args.epochs, train_batches, valid_batches, &out, |r| {
         let v = r.validation.map_or(String::new(), |v| {
             format!(
@@ -429,6 +458,31 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
         metrics.display()
     );
     Ok(())
+}
+
+/// `--checkpoint-minutes` as the interval of mid-epoch checkpoints (`None` for 0: none).
+fn checkpoint_interval(minutes: f64) -> anyhow::Result<Option<Duration>> {
+    if !(minutes.is_finite() && minutes >= 0.0) {
+        bail!("--checkpoint-minutes must be 0 (none) or more, got {minutes}");
+    }
+    Ok((minutes > 0.0).then(|| Duration::from_secs_f64(minutes * 60.0)))
+}
+
+/// The name of the training set and order a run's epochs take, which a mid-epoch checkpoint
+/// must be resumed with: the dataset, garment, sample count and a hash of the samples, the
+/// batch size, the shuffle's seed and the shards read together (the shuffle's window).
+fn training_set_name(data: &Dataset, indices: &[u64], args: &TrainArgs) -> String {
+    let bytes: Vec<u8> = indices.iter().flat_map(|k| k.to_le_bytes()).collect();
+    format!(
+        "{}:{}:{} samples (sha256 {}), batch {}, seed {}, {} shards a window",
+        data.manifest().spec.name,
+        args.garment,
+        indices.len(),
+        &dataset::hash::sha256_hex(&bytes)[..16],
+        args.batch.max(1),
+        args.seed,
+        data.cache_shards()
+    )
 }
 
 /// Fails, naming `model`, when the network `setup` learned from bodies posed another way than

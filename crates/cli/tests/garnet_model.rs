@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use common::{fails, garnet, ok, s};
+use dataset::batches::Order;
 
 /// 3 bodies (train, val, test) x T-shirt in 2 poses: 6 samples of an 8 cm T-shirt, on
 /// bodies skinned by linear blending.
@@ -799,6 +800,62 @@ fn grow_keeps_the_drapes_and_trains_on() {
         s(&tmp.path().join("x.garnet")),
     ]);
     assert!(err.contains("Naive has no mesh convolutions"), "{err}");
+}
+
+/// A run stopped inside an epoch (here by a damaged shard at its second batch) resumes from
+/// `mid-epoch.garnet` at that batch once the shard is whole again, and its epoch's row of
+/// `metrics.csv` is that of a run that never stopped; with another shuffle it refuses.
+#[test]
+fn train_resumes_an_epoch_stopped_inside() {
+    let tmp = tempfile::tempdir().unwrap();
+    let one_a_shard = SPEC.replace("shard_size = 2", "shard_size = 1");
+    let data = generate_in(tmp.path(), &one_a_shard, &["--jobs", "2"]);
+    let set = dataset::Dataset::open(&data).unwrap();
+    let train = set.select(Some("train"), Some("tshirt")).unwrap();
+    let order = Order::Shuffled { seed: 0, epoch: 0 };
+    let second = dataset::batches::epoch_order(&set, &train, order)[1];
+    let shard = set.manifest().sample(second).unwrap().shard;
+    let shard = data.join(format!("shards/shard-{shard:06}.safetensors"));
+    let whole_bytes = std::fs::read(&shard).unwrap();
+
+    let run = |out: &Path, extra: &[&str]| {
+        let mut a = train_args(&data, "local", "1", out, &["--batch", "1"]);
+        a.extend_from_slice(extra);
+        owned(&a)
+    };
+    let whole = tmp.path().join("whole");
+    ok(&as_str(&run(&whole, &[])));
+
+    let stopped = tmp.path().join("stopped");
+    let mut damaged = whole_bytes.clone();
+    let n = damaged.len();
+    damaged[n - 50] ^= 0x40;
+    std::fs::write(&shard, &damaged).unwrap();
+    let err = fails(&as_str(&run(&stopped, &["--checkpoint-minutes", "1e-6"])));
+    assert!(err.contains("checksum"), "{err}");
+    let mid = stopped.join("mid-epoch.garnet");
+    assert!(mid.is_file() && !stopped.join("last.garnet").exists());
+    std::fs::write(&shard, &whole_bytes).unwrap();
+
+    let err = fails(&as_str(&run(&stopped, &["--resume", "--seed", "5"])));
+    assert!(
+        err.contains("inside epoch 1 after 1 batches of another training set")
+            && err.contains("seed 0")
+            && err.contains("seed 5"),
+        "{err}"
+    );
+    let log = ok(&as_str(&run(&stopped, &["--resume"])));
+    assert!(log.contains("inside epoch 1, after 1 batches"), "{log}");
+    assert!(!mid.exists() && stopped.join("last.garnet").is_file());
+    // The row without its wall time (the fourth column).
+    let row = |dir: &Path| -> Vec<String> {
+        let csv = std::fs::read_to_string(dir.join("metrics.csv")).unwrap();
+        let last = csv.lines().last().unwrap().to_string();
+        let mut cells: Vec<String> = last.split(',').map(String::from).collect();
+        cells.remove(3);
+        cells
+    };
+    assert_eq!(row(&stopped), row(&whole));
 }
 
 /// `garnet train` of `variant` on `data`'s T-shirts for one epoch into `run`: its

@@ -93,6 +93,15 @@ impl<'a> Batches<'a> {
             n.div_ceil(b)
         }
     }
+
+    /// The same epoch without its first `batches` batches, which are never read: where a
+    /// training run stopped inside an epoch resumes it. Skipping past the end leaves none.
+    pub fn skip_batches(mut self, batches: usize) -> Self {
+        self.next = batches
+            .saturating_mul(self.opts.batch_size)
+            .min(self.order.len());
+        self
+    }
 }
 
 impl Iterator for Batches<'_> {

@@ -96,6 +96,18 @@ fn batches_stream_a_split_in_order_or_shuffled_per_epoch() {
         .flat_map(|b| b.unwrap().into_iter().map(|s| s.record.index))
         .collect();
     assert_eq!(seen, train);
+    // Skipping batches starts the epoch further on, reading nothing before it.
+    let rest: Vec<u64> = Batches::new(&data, &train, opts)
+        .skip_batches(1)
+        .flat_map(|b| b.unwrap().into_iter().map(|s| s.record.index))
+        .collect();
+    assert_eq!(rest, train[2..]);
+    assert_eq!(
+        Batches::new(&data, &train, opts)
+            .skip_batches(usize::MAX)
+            .count(),
+        0
+    );
     let shuffled = |epoch| epoch_order(&data, &train, Order::Shuffled { seed: 1, epoch });
     let (e0, e1) = (shuffled(0), shuffled(1));
     assert_eq!(e0, shuffled(0));

@@ -32,6 +32,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::batch::InputSpec;
 use crate::config::GarNetConfig;
+use crate::epoch_progress::EpochProgress;
 use crate::error::{ModelError, Result};
 use crate::garnet::GarNet;
 use crate::local::BodySampling;
@@ -226,6 +227,10 @@ pub struct TrainState {
     /// Whether every other training sample is mirrored left-right (see [`crate::mirror`]).
     #[serde(default)]
     pub mirror: bool,
+    /// In a mid-epoch checkpoint, how far epoch `epoch + 1` has gone (see
+    /// [`crate::trainer::MID_EPOCH_CHECKPOINT`]); `None` at an epoch's end.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub partial: Option<EpochProgress>,
 }
 
 impl TrainState {

@@ -21,7 +21,7 @@
 //! let setup = ModelSetup::new(config, template, &reference_body)?;
 //! let mut trainer = Trainer::new(setup, LossConfig::new(), PAPER_LEARNING_RATE, &Device::flex())?;
 //! let batches = || samples.chunks(4).map(|c| Ok::<_, String>(c.to_vec())).collect::<Vec<_>>();
-//! trainer.fit(100, |_epoch| batches(), Some(|| batches()), "runs/local".as_ref(), |r| {
+//! trainer.fit(100, |_epoch, _skip| batches(), Some(|| batches()), "runs/local".as_ref(), |r| {
 //!     println!("epoch {} train {:?}", r.epoch, r.train)
 //! })?;
 //! let draper = Draper::load("runs/local/best.garnet".as_ref(), &Device::flex())?;
@@ -42,6 +42,7 @@ pub mod checkpoint;
 pub mod config;
 pub mod contact;
 pub mod drape;
+pub mod epoch_progress;
 pub mod error;
 pub mod feast;
 pub mod feast_rows;

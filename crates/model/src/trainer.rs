@@ -1,10 +1,11 @@
 //! The training loop: epochs over an iterator of sample batches, validation after each
 //! epoch, `last.garnet` and `best.garnet` checkpoints (best = lowest validation E_dist) and a
-//! `metrics.csv` log; resumable from any checkpoint with its optimiser state.
+//! `metrics.csv` log; resumable from any checkpoint with its optimiser state, and from inside
+//! an epoch by its mid-epoch checkpoints.
 
 use std::fmt::Display;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use burn::optim::ModuleOptimizer;
 use burn::prelude::*;
@@ -13,6 +14,7 @@ use serde::{Deserialize, Serialize};
 use crate::batch::{Batch, InputSpec, Sample};
 use crate::checkpoint::{load_checkpoint, save_checkpoint, ModelSetup, TrainState};
 use crate::drape::Draper;
+use crate::epoch_progress::EpochProgress;
 use crate::error::{ModelError, Result};
 use crate::garnet::GarNet;
 use crate::loss::{LossConfig, LossTerms};
@@ -28,6 +30,10 @@ pub const LAST_CHECKPOINT: &str = "last.garnet";
 pub const BEST_CHECKPOINT: &str = "best.garnet";
 /// File name of the per-epoch metrics log.
 pub const METRICS_LOG: &str = "metrics.csv";
+/// File name of the checkpoint written inside an epoch (see
+/// [`Trainer::set_checkpoint_every`]): the network, optimiser and the epoch's progress so far.
+/// It is removed when the epoch ends.
+pub const MID_EPOCH_CHECKPOINT: &str = "mid-epoch.garnet";
 
 /// File name of the checkpoint that [`Trainer::set_keep_epochs`] keeps of epoch `epoch`
 /// (1-based, as in `metrics.csv`): `epoch-N.garnet`.
@@ -88,6 +94,10 @@ pub struct Trainer {
     validation_set: Option<String>,
     /// Whether each epoch also writes its own checkpoint (see [`epoch_checkpoint_name`]).
     keep_epochs: bool,
+    /// The name of the training set and order of this run (see [`Trainer::set_training_set`]).
+    training_set: Option<String>,
+    /// How often an epoch writes [`MID_EPOCH_CHECKPOINT`] (`None`: never).
+    checkpoint_every: Option<Duration>,
     device: Device,
 }
 
@@ -168,6 +178,8 @@ impl Trainer {
             mirror: None,
             validation_set: None,
             keep_epochs: false,
+            training_set: None,
+            checkpoint_every: None,
             device,
         };
         trainer.set_mirror(trainer.state.mirror)?;
@@ -216,6 +228,41 @@ impl Trainer {
     /// and that a run can branch from (copy one to another folder's `last.garnet`).
     pub fn set_keep_epochs(&mut self, keep: bool) {
         self.keep_epochs = keep;
+    }
+
+    /// Names this run's training set and the order its epochs take it in (say the dataset,
+    /// split, garment, sample count and a hash of the samples, the batch size and the
+    /// shuffle's seed). A mid-epoch checkpoint stores it, and [`Trainer::fit`] refuses to
+    /// go on with its epoch in another set or order: the batches it would skip would not be
+    /// the ones it trained on.
+    pub fn set_training_set(&mut self, name: &str) {
+        self.training_set = Some(name.to_string());
+    }
+
+    /// While an epoch trains, writes [`MID_EPOCH_CHECKPOINT`] to the run's folder once
+    /// `every` has passed since the epoch's start or the last such write (`None`: never),
+    /// so that a run stopped inside an epoch resumes there ([`Trainer::resume_point`]).
+    pub fn set_checkpoint_every(&mut self, every: Option<Duration>) {
+        self.checkpoint_every = every;
+    }
+
+    /// The checkpoint a run in `out_dir` resumes from: [`MID_EPOCH_CHECKPOINT`] when it is
+    /// further on than [`LAST_CHECKPOINT`] (more steps), else [`LAST_CHECKPOINT`]; `None`
+    /// when neither exists. Fails when a file cannot be read as a checkpoint.
+    pub fn resume_point(out_dir: &Path) -> Result<Option<PathBuf>> {
+        let (last, _, _) = Trainer::output_paths(out_dir);
+        let mid = out_dir.join(MID_EPOCH_CHECKPOINT);
+        let steps = |p: &Path| -> Result<Option<u64>> {
+            match p.is_file() {
+                true => Ok(Some(load_checkpoint(p)?.state.step)),
+                false => Ok(None),
+            }
+        };
+        Ok(match (steps(&mid)?, steps(&last)?) {
+            (Some(m), l) if l.is_none_or(|l| m > l) => Some(mid),
+            (_, Some(_)) => Some(last),
+            _ => None,
+        })
     }
 
     /// The learning rate.
@@ -335,32 +382,41 @@ impl Trainer {
     }
 
     /// One pass over `batches` (each a `Vec<Sample>` or the data source's error), one step
-    /// per batch; returns the loss terms averaged over samples, the sample count and the
-    /// mean gradient norm over steps. Does not advance the epoch counter (see
+    /// per batch, going on from the progress a mid-epoch checkpoint brought (whose batches
+    /// `batches` must leave out); writes [`MID_EPOCH_CHECKPOINT`] to `out_dir` as
+    /// [`Trainer::set_checkpoint_every`] says. Returns the epoch's progress: its loss terms
+    /// and gradient norms summed over every sitting. Does not advance the epoch counter (see
     /// [`Trainer::run_epoch`]).
-    pub fn train_epoch<I, E>(&mut self, batches: I) -> Result<(LossTerms, usize, f32)>
+    pub fn train_epoch<I, E>(&mut self, batches: I, out_dir: Option<&Path>) -> Result<EpochProgress>
     where
         I: IntoIterator<Item = std::result::Result<Vec<Sample>, E>>,
         E: Display,
     {
-        let mut sum = LossTerms::default();
-        let (mut count, mut steps, mut norm_sum) = (0usize, 0usize, 0.0f64);
+        let mut progress = self
+            .state
+            .partial
+            .take()
+            .unwrap_or_else(|| EpochProgress::new(self.training_set.clone()));
+        let (start, before) = (Instant::now(), progress.seconds);
+        let mut saved = start;
         for batch in batches {
             let samples = batch.map_err(|e| ModelError::Data(e.to_string()))?;
             if samples.is_empty() {
+                progress.add_empty();
                 continue;
             }
             let report = self.step(&samples)?;
-            sum = sum + report.terms.scaled(samples.len() as f32);
-            count += samples.len();
-            steps += 1;
-            norm_sum += report.grad_norm as f64;
+            progress.add(&report, samples.len());
+            progress.seconds = before + start.elapsed().as_secs_f64();
+            let due = self.checkpoint_every.is_some_and(|e| saved.elapsed() >= e);
+            if let (Some(dir), true) = (out_dir, due) {
+                self.state.partial = Some(progress);
+                self.save(&dir.join(MID_EPOCH_CHECKPOINT))?;
+                progress = self.state.partial.take().unwrap_or_default();
+                saved = Instant::now();
+            }
         }
-        Ok((
-            sum.scaled(1.0 / count.max(1) as f32),
-            count,
-            (norm_sum / steps.max(1) as f64) as f32,
-        ))
+        Ok(progress)
     }
 
     /// Evaluates the network (without autodiff) on `batches`; averages over samples.
@@ -445,9 +501,12 @@ impl Trainer {
         if let Some(s) = self.state.schedule {
             self.lr = s.lr(self.state.epoch);
         }
-        let (train_terms, train_samples, grad_norm) = self.train_epoch(train)?;
         self.state.averaged_epochs.clear();
         self.state.averaged_weights.clear();
+        let earlier_sittings = self.state.partial.as_ref().map_or(0.0, |p| p.seconds);
+        let trained = self.train_epoch(train, Some(out_dir))?;
+        let (train_terms, train_samples) = (trained.mean_terms(), trained.samples);
+        let grad_norm = trained.mean_grad_norm();
         let validation = match valid {
             Some(v) => Some(self.validate(v)?),
             None => None,
@@ -471,7 +530,14 @@ impl Trainer {
         if self.keep_epochs {
             self.save(&out_dir.join(epoch_checkpoint_name(self.state.epoch)))?;
         }
-        let seconds = start.elapsed().as_secs_f64();
+        let mid = out_dir.join(MID_EPOCH_CHECKPOINT);
+        if mid.is_file() {
+            std::fs::remove_file(&mid).map_err(|e| ModelError::Io {
+                path: mid,
+                source: e,
+            })?;
+        }
+        let seconds = earlier_sittings + start.elapsed().as_secs_f64();
         let row = MetricsRow {
             epoch: self.state.epoch,
             step: self.state.step,
@@ -498,8 +564,11 @@ impl Trainer {
     }
 
     /// Runs epochs until `epochs` are completed (counting those of a resumed checkpoint):
-    /// `train(epoch)` gives the training batches of each epoch (shuffle there), `valid()` the
-    /// validation batches; `on_epoch` sees each report. Returns the reports of this call.
+    /// `train(epoch, skip)` gives the training batches of each epoch (shuffle there) without
+    /// its first `skip`, which a mid-epoch checkpoint trained already (0 otherwise);
+    /// `valid()` the validation batches; `on_epoch` sees each report. Returns the reports of
+    /// this call. Fails before training when a mid-epoch checkpoint's epoch was taken from
+    /// another training set than [`Trainer::set_training_set`] names.
     pub fn fit<I, J, E, FT, FV, FR>(
         &mut self,
         epochs: usize,
@@ -512,15 +581,33 @@ impl Trainer {
         I: IntoIterator<Item = std::result::Result<Vec<Sample>, E>>,
         J: IntoIterator<Item = std::result::Result<Vec<Sample>, E>>,
         E: Display,
-        FT: FnMut(usize) -> I,
+        FT: FnMut(usize, usize) -> I,
         FV: FnMut() -> J,
         FR: FnMut(&EpochReport),
     {
+        if let Some(p) = &self.state.partial {
+            if p.training_set != self.training_set {
+                let name = |s: &Option<String>| s.clone().unwrap_or_else(|| "unnamed".into());
+                return Err(ModelError::InvalidInput(format!(
+                    "the checkpoint stopped inside epoch {} after {} batches of another training \
+                     set or order ({}; this run: {}): go on with the same data, batch size and \
+                     seed, or delete {} to train epoch {} afresh from {}",
+                    self.state.epoch + 1,
+                    p.batches,
+                    name(&p.training_set),
+                    name(&self.training_set),
+                    MID_EPOCH_CHECKPOINT,
+                    self.state.epoch + 1,
+                    LAST_CHECKPOINT,
+                )));
+            }
+        }
         let mut reports = Vec::new();
         while self.state.epoch < epochs {
             let epoch = self.state.epoch;
+            let skip = self.state.partial.as_ref().map_or(0, |p| p.batches);
             let v = valid.as_mut().map(|f| f());
-            let report = self.run_epoch(train(epoch), v, out_dir)?;
+            let report = self.run_epoch(train(epoch, skip), v, out_dir)?;
             on_epoch(&report);
             reports.push(report);
         }

@@ -513,7 +513,7 @@ fn trainer_writes_checkpoints_and_metrics_and_resumes() {
     let reports = trainer
         .fit(
             2,
-            |_| train(),
+            |_, _| train(),
             Some(valid),
             dir.path(),
             |r| seen.push(r.epoch),
@@ -549,7 +549,7 @@ fn trainer_writes_checkpoints_and_metrics_and_resumes() {
     resumed.set_schedule(Some(CosineSchedule::new(1e-3, 1e-4, 2, 3).unwrap()));
     assert_eq!(resumed.state().schedule, Some(schedule));
     let more = resumed
-        .fit(3, |_| train(), Some(valid), dir.path(), |_| {})
+        .fit(3, |_, _| train(), Some(valid), dir.path(), |_| {})
         .unwrap();
     assert_eq!(more.len(), 1);
     assert_eq!(more[0].epoch, 3);
@@ -719,7 +719,7 @@ fn best_starts_afresh_on_another_validation_set() {
     let mut trainer = Trainer::new(s, LossConfig::new(), 1e-3, &device).unwrap();
     assert_eq!(trainer.set_validation_set("set-a:tube"), None);
     trainer
-        .fit(1, |_| train(), Some(valid), dir.path(), |_| {})
+        .fit(1, |_, _| train(), Some(valid), dir.path(), |_| {})
         .unwrap();
     let (last, best, _) = Trainer::output_paths(dir.path());
     let state = load_checkpoint(&best).unwrap().state;
@@ -745,7 +745,7 @@ fn best_starts_afresh_on_another_validation_set() {
     let mut resumed = Trainer::resume(&last, None, &device).unwrap();
     assert_eq!(resumed.set_validation_set("set-b:tube"), Some(1e-6));
     let reports = resumed
-        .fit(2, |_| train(), Some(valid), dir.path(), |_| {})
+        .fit(2, |_, _| train(), Some(valid), dir.path(), |_| {})
         .unwrap();
     assert!(reports[0].is_best && best.is_file());
     let state = load_checkpoint(&best).unwrap().state;
@@ -764,7 +764,7 @@ fn kept_epochs_are_checkpoints_to_branch_from() {
     let train = || vec![Ok::<_, String>(data.clone())];
     trainer.set_keep_epochs(true);
     trainer
-        .fit(2, |_| train(), NO_VALIDATION, trunk.path(), |_| {})
+        .fit(2, |_, _| train(), NO_VALIDATION, trunk.path(), |_| {})
         .unwrap();
     let params = |path: &std::path::Path| {
         let epoch = load_checkpoint(path).unwrap().state.epoch;
@@ -783,10 +783,137 @@ fn kept_epochs_are_checkpoints_to_branch_from() {
     std::fs::copy(trunk.path().join(epoch_checkpoint_name(1)), &branch_last).unwrap();
     let mut resumed = Trainer::resume(&branch_last, None, &device).unwrap();
     resumed
-        .fit(2, |_| train(), NO_VALIDATION, branch.path(), |_| {})
+        .fit(2, |_, _| train(), NO_VALIDATION, branch.path(), |_| {})
         .unwrap();
     assert_eq!(params(&branch_last), kept[1]);
     assert!(!branch.path().join(epoch_checkpoint_name(2)).exists());
+}
+
+/// An epoch stopped inside (here by a data error after two of its four batches) resumes from
+/// its mid-epoch checkpoint at the next batch, and ends with the network, optimiser and
+/// epoch report of a run that never stopped; the checkpoint is gone once the epoch ends. A
+/// run on another training set or order refuses to go on with that epoch.
+#[test]
+fn an_epoch_stopped_inside_resumes_where_it_stopped() {
+    let device = Device::flex();
+    let s = setup(Variant::Global, 40);
+    let data = samples(&s, 4);
+    let batches = |skip: usize| -> SampleBatches {
+        data.chunks(1).skip(skip).map(|c| Ok(c.to_vec())).collect()
+    };
+    let fresh = || {
+        let mut t = Trainer::new(s.clone(), LossConfig::new(), 1e-3, &device).unwrap();
+        t.set_training_set("set-a");
+        t
+    };
+    let whole = tempfile::tempdir().unwrap();
+    let reports = fresh()
+        .fit(
+            2,
+            |_, skip| batches(skip),
+            NO_VALIDATION,
+            whole.path(),
+            |_| {},
+        )
+        .unwrap();
+
+    let dir = tempfile::tempdir().unwrap();
+    assert_eq!(Trainer::resume_point(dir.path()).unwrap(), None);
+    let mut stopped = fresh();
+    stopped.set_checkpoint_every(Some(std::time::Duration::ZERO));
+    let err = stopped
+        .fit(
+            2,
+            |epoch, skip| match epoch {
+                0 => batches(skip),
+                _ => {
+                    let mut b = batches(skip);
+                    b.insert(2, Err("the session ended".into()));
+                    b
+                }
+            },
+            NO_VALIDATION,
+            dir.path(),
+            |_| {},
+        )
+        .unwrap_err();
+    assert!(err.to_string().contains("the session ended"));
+    let mid = dir.path().join(model::trainer::MID_EPOCH_CHECKPOINT);
+    assert_eq!(
+        Trainer::resume_point(dir.path()).unwrap(),
+        Some(mid.clone())
+    );
+    let state = load_checkpoint(&mid).unwrap().state;
+    assert_eq!((state.epoch, state.step), (1, 6));
+    assert_eq!(state.partial.as_ref().map(|p| p.batches), Some(2));
+
+    let mut elsewhere = Trainer::resume(&mid, None, &device).unwrap();
+    elsewhere.set_training_set("set-b");
+    let refused = elsewhere
+        .fit(
+            2,
+            |_, skip| batches(skip),
+            NO_VALIDATION,
+            dir.path(),
+            |_| {},
+        )
+        .unwrap_err()
+        .to_string();
+    assert!(
+        refused.contains("epoch 2 after 2 batches") && refused.contains("set-a"),
+        "{refused}"
+    );
+
+    let mut resumed = Trainer::resume(&mid, None, &device).unwrap();
+    resumed.set_training_set("set-a");
+    let mut skipped = Vec::new();
+    let rest = resumed
+        .fit(
+            2,
+            |_, skip| {
+                skipped.push(skip);
+                batches(skip)
+            },
+            NO_VALIDATION,
+            dir.path(),
+            |_| {},
+        )
+        .unwrap();
+    assert_eq!(skipped, vec![2]);
+    assert_eq!(rest[0].train, reports[1].train);
+    assert_eq!(rest[0].grad_norm, reports[1].grad_norm);
+    assert_eq!(rest[0].train_samples, 4);
+    assert!(!mid.exists());
+    let (last, _, _) = Trainer::output_paths(dir.path());
+    let (whole_last, _, _) = Trainer::output_paths(whole.path());
+    assert_eq!(
+        Trainer::resume_point(dir.path()).unwrap(),
+        Some(last.clone())
+    );
+    assert_eq!(
+        checkpoint_params(&last, &device),
+        checkpoint_params(&whole_last, &device)
+    );
+    let state = load_checkpoint(&last).unwrap().state;
+    assert_eq!((state.step, &state.partial), (8, &None));
+    assert_eq!(state, load_checkpoint(&whole_last).unwrap().state);
+    // Adam's moments too: one more epoch from each gives the same network.
+    for path in [&last, &whole_last] {
+        let mut t = Trainer::resume(path, None, &device).unwrap();
+        t.set_training_set("set-a");
+        t.fit(
+            3,
+            |_, skip| batches(skip),
+            NO_VALIDATION,
+            path.parent().unwrap(),
+            |_| {},
+        )
+        .unwrap();
+    }
+    assert_eq!(
+        checkpoint_params(&last, &device),
+        checkpoint_params(&whole_last, &device)
+    );
 }
 
 /// No validation data, for [`Trainer::fit`].
@@ -822,7 +949,7 @@ fn averaged_checkpoint_holds_the_mean_network() {
     trainer.set_command("garnet train x".into());
     trainer.set_keep_epochs(true);
     trainer
-        .fit(3, |_| train(), NO_VALIDATION, dir.path(), |_| {})
+        .fit(3, |_, _| train(), NO_VALIDATION, dir.path(), |_| {})
         .unwrap();
     let snapshots: Vec<_> = (1..=3)
         .map(|e| dir.path().join(epoch_checkpoint_name(e)))
