@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use crate::config::GarNetConfig;
 use crate::error::Result;
 use crate::init::ParamInit;
-use crate::layers::{lrelu, max_points, maximum, PointMlp};
+use crate::layers::{lrelu, maximum, PointMlp};
 use crate::local::LocalIndices;
 use crate::stn::Stn;
 use crate::tensors::{read_f32, read_i64, untracked_on_flex, vec_tensor};
@@ -61,9 +61,8 @@ impl BodyStream {
     /// `body` `[B,V,3]` (metres) -> point-wise `[B,V,Cb]` and global `[B,Cb]` features.
     pub fn forward(&self, body: Tensor<3>) -> BodyFeatures {
         let x = self.input_stn.forward(body);
-        let f1 = self.feature_stn.forward(self.mlp1.forward(x.clone()));
-        let points = self.mlp2.forward(Tensor::cat(vec![f1, x], 2));
-        let global = max_points(points.clone());
+        let f1 = self.feature_stn.forward(self.mlp1.rows(vec![x.clone()]));
+        let (points, global) = self.mlp2.rows_and_pooled(vec![f1, x]);
         BodyFeatures { points, global }
     }
 }

@@ -192,7 +192,7 @@ fn factors(xin: &[f32], d_in: usize, u: &[f32], c: &[f32]) -> Option<(Vec<f32>, 
 
 /// `dst` `[R, n] += src [R, k] x weight [k, n]`, all row-major (n from `weight`'s length),
 /// by `gemm` on this thread.
-fn add_product(dst: &mut [f32], src: &[f32], weight: &[f32], k: usize) {
+pub(crate) fn add_product(dst: &mut [f32], src: &[f32], weight: &[f32], k: usize) {
     let n = weight.len() / k.max(1);
     let rows = dst.len() / n.max(1);
     if rows == 0 || n == 0 || k == 0 || src.len() != rows * k || weight.len() != k * n {

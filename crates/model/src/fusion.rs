@@ -6,8 +6,9 @@
 use burn::nn::Linear;
 use burn::prelude::*;
 
+use crate::dense_rows::{chain_tensors, HostLayer};
 use crate::init::ParamInit;
-use crate::layers::{lrelu, CondLinear};
+use crate::layers::{cat_features, lrelu, CondLinear};
 
 /// Fusion MLP.
 #[derive(Module, Debug)]
@@ -39,8 +40,23 @@ impl Fusion {
         Fusion { first, hidden, out }
     }
 
-    /// `per_vertex` `[B,N,d_vertex]`, `global` `[B,d_global]` -> translations `[B,N,3]`.
-    pub fn forward(&self, per_vertex: Tensor<3>, global: Tensor<2>) -> Tensor<3> {
+    /// `per_vertex` `[B,N,d_i]` parts (concatenated along the features: `d_vertex` in all),
+    /// `global` `[B,d_global]` -> translations `[B,N,3]`. Untracked on flex, the four blocks
+    /// run as plain loops ([`crate::dense_rows`]) and the parts are never concatenated.
+    pub fn forward(&self, per_vertex: Vec<Tensor<3>>, global: Tensor<2>) -> Tensor<3> {
+        let layers = || {
+            let first = self.first.host_layer(global.clone(), true)?;
+            let mut layers = vec![first];
+            for l in &self.hidden {
+                layers.push(HostLayer::read(l, true)?);
+            }
+            layers.push(HostLayer::read(&self.out, false)?);
+            Ok(layers)
+        };
+        if let Some((Some(rows), _)) = chain_tensors(&per_vertex, layers, true, false) {
+            return rows;
+        }
+        let per_vertex = cat_features(per_vertex);
         let bias = self.first.cond_bias(global);
         let h = lrelu(self.first.forward(per_vertex, bias));
         let h = self.hidden.iter().fold(h, |h, l| lrelu(l.forward(h)));

@@ -12,11 +12,12 @@ use burn::prelude::*;
 
 use crate::config::GarNetConfig;
 use crate::contact::CONTACT_WIDTH;
+use crate::dense_rows::{chain_tensors, HostLayer};
 use crate::error::Result;
 use crate::feast::FeaStConv;
 use crate::feast_rows::Epilogue;
 use crate::init::ParamInit;
-use crate::layers::{lrelu, max_points, CondLinear};
+use crate::layers::{cat_features, lrelu, max_points, CondLinear};
 use crate::stn::Stn;
 use crate::tensors::{read_f32, untracked_on_flex, vec_tensor};
 use crate::topology::TopologyTensors;
@@ -254,15 +255,8 @@ impl GarmentStream {
         extra: Vec<Tensor<3>>,
         topo: &TopologyTensors,
     ) -> GarmentFeatures {
-        let mut h = self.stn.forward(warped.clone());
-        if !extra.is_empty() {
-            h = Tensor::cat([vec![h], extra].concat(), 2);
-        }
-        for layer in &self.mlp {
-            let bias = layer.cond_bias(body_global.clone());
-            h = lrelu(layer.forward(h, bias));
-        }
-        let points = h;
+        let parts = [vec![self.stn.forward(warped.clone())], extra].concat();
+        let points = self.point_features(parts, body_global);
         let patches = if self.blocks.is_empty() {
             None
         } else {
@@ -279,14 +273,45 @@ impl GarmentStream {
             Some(c)
         };
         let g_in = match &patches {
-            Some(c) => Tensor::cat(vec![points.clone(), c.clone()], 2),
-            None => points.clone(),
+            Some(c) => vec![points.clone(), c.clone()],
+            None => vec![points.clone()],
         };
-        let global = max_points(lrelu(self.global.forward(g_in)));
         GarmentFeatures {
             points,
             patches,
-            global,
+            global: self.global_feature(g_in),
+        }
+    }
+
+    /// The point-wise MLP on `parts` `[B,N,d_i]` (concatenated along the features), each
+    /// layer conditioned on `body_global` `[B,Cb]` -> `[B,N,P]`; as plain loops where the
+    /// parts are untracked on flex ([`crate::dense_rows`]).
+    fn point_features(&self, parts: Vec<Tensor<3>>, body_global: Tensor<2>) -> Tensor<3> {
+        let layers = || {
+            self.mlp
+                .iter()
+                .map(|l| l.host_layer(body_global.clone(), true))
+                .collect()
+        };
+        if let Some((Some(rows), _)) = chain_tensors(&parts, layers, true, false) {
+            return rows;
+        }
+        let mut h = cat_features(parts);
+        for layer in &self.mlp {
+            let bias = layer.cond_bias(body_global.clone());
+            h = lrelu(layer.forward(h, bias));
+        }
+        h
+    }
+
+    /// The global garment feature `[B,G]`: the shared layer on `parts` `[B,N,d_i]`
+    /// (concatenated along the features), max-pooled over the vertices; as plain loops
+    /// where the parts are untracked on flex, without writing the layer's `[B,N,G]` out.
+    fn global_feature(&self, parts: Vec<Tensor<3>>) -> Tensor<2> {
+        let layers = || Ok(vec![HostLayer::read(&self.global, true)?]);
+        match chain_tensors(&parts, layers, false, true) {
+            Some((_, Some(global))) => global,
+            _ => max_points(lrelu(self.global.forward(cat_features(parts)))),
         }
     }
 }

@@ -168,11 +168,6 @@ impl GarNet {
             }
             per_vertex.push(pool.forward(body_features.points, idx));
         }
-        let per_vertex = if per_vertex.len() == 1 {
-            per_vertex.pop().expect("one element")
-        } else {
-            Tensor::cat(per_vertex, 2)
-        };
         let global = Tensor::cat(vec![garment.global, body_features.global], 1);
         Ok(self.fusion.forward(per_vertex, global) * unit)
     }

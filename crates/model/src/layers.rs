@@ -4,7 +4,10 @@
 use burn::nn::Linear;
 use burn::prelude::*;
 
+use crate::dense_rows::{chain_tensors, HostLayer};
+use crate::error::Result;
 use crate::init::{ParamInit, LEAKY_SLOPE};
+use crate::tensors::read_f32;
 
 /// LeakyReLU with GarNet's slope 0.1. On a tensor tracked by autodiff, as `x * s` with the
 /// slope `s` (1 where `x >= 0`, else 0.1) computed outside the graph: the same values and
@@ -20,6 +23,14 @@ pub fn lrelu<const D: usize>(x: Tensor<D>) -> Tensor<D> {
     let slope =
         x.clone().detach().greater_equal_elem(0.0).float() * (1.0 - LEAKY_SLOPE) + LEAKY_SLOPE;
     x * slope
+}
+
+/// `parts` `[B,P,d_i]` concatenated along the features (the one part itself).
+pub fn cat_features(mut parts: Vec<Tensor<3>>) -> Tensor<3> {
+    match parts.len() {
+        1 => parts.remove(0),
+        _ => Tensor::cat(parts, 2),
+    }
 }
 
 /// Element-wise maximum of `a` and `b` (same shape) as `a m + b (1 - m)`, `m = [a > b]`
@@ -100,6 +111,44 @@ impl PointMlp {
             .fold(x, |x, layer| lrelu(layer.forward(x)))
     }
 
+    /// The layers on the host, LeakyReLU after each (see [`crate::dense_rows`]).
+    pub fn host_layers(&self) -> Result<Vec<HostLayer>> {
+        self.layers
+            .iter()
+            .map(|l| HostLayer::read(l, true))
+            .collect()
+    }
+
+    /// [`PointMlp::forward`] of `parts` `[B,P,d_i]` concatenated along the features (`d_in`
+    /// in all) -> `[B,P,d_out]`; as plain loops where the parts are untracked on flex
+    /// ([`crate::dense_rows`]: never concatenated), with burn's ops otherwise.
+    pub fn rows(&self, parts: Vec<Tensor<3>>) -> Tensor<3> {
+        match chain_tensors(&parts, || self.host_layers(), true, false) {
+            Some((Some(rows), _)) => rows,
+            _ => self.forward(cat_features(parts)),
+        }
+    }
+
+    /// The max pooling `[B,d_out]` of [`PointMlp::rows`], where the plain loops never write
+    /// the rows out.
+    pub fn pooled(&self, parts: Vec<Tensor<3>>) -> Tensor<2> {
+        match chain_tensors(&parts, || self.host_layers(), false, true) {
+            Some((_, Some(pooled))) => pooled,
+            _ => max_points(self.forward(cat_features(parts))),
+        }
+    }
+
+    /// [`PointMlp::rows`] and their max pooling, in one pass of the plain loops.
+    pub fn rows_and_pooled(&self, parts: Vec<Tensor<3>>) -> (Tensor<3>, Tensor<2>) {
+        match chain_tensors(&parts, || self.host_layers(), true, true) {
+            Some((Some(rows), Some(pooled))) => (rows, pooled),
+            _ => {
+                let rows = self.forward(cat_features(parts));
+                (rows.clone(), max_points(rows))
+            }
+        }
+    }
+
     /// Output width.
     pub fn d_out(&self) -> usize {
         self.layers
@@ -131,6 +180,13 @@ impl CondLinear {
     ) -> Self {
         let (point, cond) = init.hidden_split(d_point, d_cond, d_out, device);
         CondLinear { point, cond }
+    }
+
+    /// The layer on the host for the samples of `c` `[B,d_cond]`: `W_x`, `b` and the
+    /// per-sample bias `W_c c`, LeakyReLU after when `lrelu` (see [`crate::dense_rows`]).
+    pub fn host_layer(&self, c: Tensor<2>, lrelu: bool) -> Result<HostLayer> {
+        let per_sample = read_f32(self.cond.forward(c))?;
+        Ok(HostLayer::read(&self.point, lrelu)?.with_sample_bias(&per_sample))
     }
 
     /// The per-sample bias `W_c c`: `c` `[B,d_cond]` -> `[B,1,d_out]`.

@@ -41,6 +41,7 @@ pub mod body_stream;
 pub mod checkpoint;
 pub mod config;
 pub mod contact;
+pub mod dense_rows;
 pub mod drape;
 pub mod epoch_progress;
 pub mod error;

@@ -5,7 +5,7 @@ use burn::nn::Linear;
 use burn::prelude::*;
 
 use crate::init::ParamInit;
-use crate::layers::{lrelu, max_points, PointMlp};
+use crate::layers::{lrelu, PointMlp};
 
 /// A spatial transformer for `k`-dimensional point features: shared per-point MLP, max pooling
 /// over points, fully connected layers, then a zero-initialised layer to `k*k` values added to
@@ -55,7 +55,7 @@ impl Stn {
     /// The predicted transforms: `x` `[B,P,k]` -> `[B,k,k]` (identity plus the learned part).
     pub fn transform(&self, x: Tensor<3>) -> Tensor<3> {
         let [b, _, k] = x.dims();
-        let pooled = max_points(self.mlp.forward(x.clone()));
+        let pooled = self.mlp.pooled(vec![x.clone()]);
         let h = self
             .fc
             .iter()
