@@ -147,6 +147,38 @@ impl InputSpec {
         (frames, bodies, warped)
     }
 
+    /// The contact features `[B,N,CONTACT_WIDTH]` of `bodies` `[B][V]` and `warped` `[B][N]`
+    /// when the spec has them (see [`InputSpec::inputs`]).
+    fn contact(
+        &self,
+        bodies: &[&[Vec3]],
+        known: Option<KnownBodies>,
+        warped: &[&[Vec3]],
+        device: &Device,
+    ) -> Result<Option<Tensor<3>>> {
+        let Some(faces) = &self.contact_faces else {
+            return Ok(None);
+        };
+        let mut flat = Vec::new();
+        for (b, (body, m)) in bodies.iter().zip(warped).enumerate() {
+            let features = match &known {
+                Some(k) => contact_features(&k.index[b], body, k.normals[b], m)?,
+                None => {
+                    geom::adjacency::check_indices(body.len(), faces)?;
+                    let normals = geom::normals::vertex_normals(body, faces);
+                    contact_features(&geom::KnnIndex::new(body)?, body, &normals, m)?
+                }
+            };
+            flat.extend(features);
+        }
+        let n = warped.first().map_or(0, |m| m.len());
+        Ok(Some(vec_tensor(
+            flat,
+            [warped.len(), n, CONTACT_WIDTH],
+            device,
+        )))
+    }
+
     /// The network inputs of B samples: stream points `[B][P]` of `bodies` `[B][V]`, and the
     /// local tables and the contact features `[B,N,CONTACT_WIDTH]` of them and `warped`
     /// `[B][N]` (metres, one frame) when the spec has them. The contact features take what
@@ -164,36 +196,19 @@ impl InputSpec {
             .map(|b| self.sampling.stream_points(b))
             .collect::<Result<Vec<_>>>()?;
         let refs: Vec<&[Vec3]> = streams.iter().map(Vec::as_slice).collect();
-        let local = match self.local {
-            Some((pool_k, knn_k)) => Some(LocalIndices::build(
-                &self.sampling,
-                pool_k,
-                knn_k,
-                &refs,
-                warped,
-                device,
-            )?),
-            None => None,
-        };
-        let contact = match &self.contact_faces {
-            Some(faces) => {
-                let mut flat = Vec::new();
-                for (b, (body, m)) in bodies.iter().zip(warped).enumerate() {
-                    let features = match &known {
-                        Some(k) => contact_features(&k.index[b], body, k.normals[b], m)?,
-                        None => {
-                            geom::adjacency::check_indices(body.len(), faces)?;
-                            let normals = geom::normals::vertex_normals(body, faces);
-                            contact_features(&geom::KnnIndex::new(body)?, body, &normals, m)?
-                        }
-                    };
-                    flat.extend(features);
+        // The local tables and the contact features side by side: each builds k-d trees on
+        // one thread before its queries spread over all of them.
+        let (local, contact) = rayon::join(
+            || match self.local {
+                Some((pool_k, knn_k)) => {
+                    LocalIndices::build(&self.sampling, pool_k, knn_k, &refs, warped, device)
+                        .map(Some)
                 }
-                let n = warped.first().map_or(0, |m| m.len());
-                Some(vec_tensor(flat, [warped.len(), n, CONTACT_WIDTH], device))
-            }
-            None => None,
-        };
+                None => Ok(None),
+            },
+            || self.contact(bodies, known, warped, device),
+        );
+        let (local, contact) = (local?, contact?);
         let rest = self.rest_input.as_ref().map(|r| {
             let copies: Vec<&[Vec3]> = warped.iter().map(|_| r.as_slice()).collect();
             points_tensor(&copies, device)
