@@ -180,8 +180,9 @@ pub struct AverageReport {
 /// to `out` without optimiser state (a resumed run starts Adam afresh). With `weights`
 /// (one per input, summing to 1; see [`combine_networks`]) it writes that weighted
 /// combination instead of the plain mean. The written
-/// progress is the last input's, without a best validation figure, and its command is the
-/// last input's followed by `command`.
+/// progress is the last input's, without a best validation figure nor an epoch stopped
+/// inside (a run from it begins its next epoch afresh), and its command is the last input's
+/// followed by `command`.
 pub fn average_checkpoints(
     inputs: &[&Path],
     weights: Option<&[f64]>,
@@ -234,6 +235,8 @@ pub fn average_checkpoints(
     state.validation = None;
     state.averaged_epochs = epochs.clone();
     state.averaged_weights = weights.map(<[f64]>::to_vec).unwrap_or_default();
+    // Not the network any epoch stopped in: a run from it begins its next epoch afresh.
+    state.partial = None;
     state.append_command(command);
     save_checkpoint(out, &mean, None, &setup, &loss, &state)?;
     Ok(AverageReport {

@@ -64,7 +64,8 @@ pub struct GrowPlan {
 }
 
 /// Reads the checkpoint `input`, grows its network as `plan` says and writes it to `out`
-/// without optimiser state (a resumed run starts Adam afresh). Progress and the best
+/// without optimiser state (a resumed run starts Adam afresh). Progress (but not that of an
+/// epoch it stopped inside: a run from it begins its next epoch afresh) and the best
 /// validation figure carry over (the grown network drapes as its parent); `command` is
 /// recorded after the training command. Returns the grown network's parameter count.
 pub fn grow_checkpoint(input: &Path, out: &Path, plan: &GrowPlan, command: &str) -> Result<usize> {
@@ -88,6 +89,8 @@ pub fn grow_checkpoint(input: &Path, out: &Path, plan: &GrowPlan, command: &str)
     let mut setup = ck.setup;
     setup.config = config;
     let mut state = ck.state;
+    // Not the network any epoch stopped in: a run from it begins its next epoch afresh.
+    state.partial = None;
     state.append_command(command);
     save_checkpoint(out, &model, None, &setup, &ck.loss, &state)?;
     Ok(model.num_params())

@@ -889,6 +889,20 @@ fn an_epoch_stopped_inside_resumes_where_it_stopped() {
     let state = load_checkpoint(&mid).unwrap().state;
     assert_eq!((state.epoch, state.step), (1, 6));
     assert_eq!(state.partial.as_ref().map(|p| p.batches), Some(2));
+    // A network made from it (an average, a grown one) begins its next epoch afresh.
+    let made = dir.path().join("made");
+    std::fs::create_dir(&made).unwrap();
+    let mean = made.join("mean.garnet");
+    average_checkpoints(&[&mid, &mid], None, &mean, "garnet average").unwrap();
+    let grown = made.join("grown.garnet");
+    let plan = GrowPlan {
+        extra_blocks: 1,
+        ..GrowPlan::default()
+    };
+    grow_checkpoint(&mid, &grown, &plan, "garnet grow").unwrap();
+    for path in [&mean, &grown] {
+        assert_eq!(load_checkpoint(path).unwrap().state.partial, None);
+    }
 
     let mut elsewhere = Trainer::resume(&mid, None, &device).unwrap();
     elsewhere.set_training_set("set-b");
