@@ -302,6 +302,16 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
                 out.join(model::trainer::LAST_CHECKPOINT).display()
             );
         }
+        // A stopped epoch of the run this one replaces: --resume must not go back to it.
+        let stale = out.join(model::trainer::MID_EPOCH_CHECKPOINT);
+        if stale.is_file() {
+            std::fs::remove_file(&stale)
+                .with_context(|| format!("removing {}", stale.display()))?;
+            eprintln!(
+                "removed {}: it was a stopped epoch of the run this one replaces",
+                stale.display()
+            );
+        }
         let template = train.template()?;
         let garment_file = template.to_bytes(&args.data)?;
         let mut config = match &args.config {

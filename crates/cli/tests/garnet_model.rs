@@ -856,6 +856,12 @@ fn train_resumes_an_epoch_stopped_inside() {
         cells
     };
     assert_eq!(row(&stopped), row(&whole));
+
+    // A run started afresh in the folder removes a stopped epoch left there, so that a later
+    // --resume cannot go back to it.
+    std::fs::copy(stopped.join("last.garnet"), &mid).unwrap();
+    let log = ok(&as_str(&run(&stopped, &[])));
+    assert!(log.contains("removed") && !mid.exists(), "{log}");
 }
 
 /// `garnet train` of `variant` on `data`'s T-shirts for one epoch into `run`: its
