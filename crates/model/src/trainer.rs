@@ -397,6 +397,27 @@ impl Trainer {
             .partial
             .take()
             .unwrap_or_else(|| EpochProgress::new(self.training_set.clone()));
+        match self.train_batches(batches, &mut progress, out_dir) {
+            Ok(()) => Ok(progress),
+            Err(e) => {
+                // Stopped inside the epoch: a later `fit` on this trainer goes on from here.
+                self.state.partial = Some(progress);
+                Err(e)
+            }
+        }
+    }
+
+    /// The steps of [`Trainer::train_epoch`], counted into `progress`.
+    fn train_batches<I, E>(
+        &mut self,
+        batches: I,
+        progress: &mut EpochProgress,
+        out_dir: Option<&Path>,
+    ) -> Result<()>
+    where
+        I: IntoIterator<Item = std::result::Result<Vec<Sample>, E>>,
+        E: Display,
+    {
         let (start, before) = (Instant::now(), progress.seconds);
         let mut saved = start;
         for batch in batches {
@@ -410,13 +431,14 @@ impl Trainer {
             progress.seconds = before + start.elapsed().as_secs_f64();
             let due = self.checkpoint_every.is_some_and(|e| saved.elapsed() >= e);
             if let (Some(dir), true) = (out_dir, due) {
-                self.state.partial = Some(progress);
-                self.save(&dir.join(MID_EPOCH_CHECKPOINT))?;
-                progress = self.state.partial.take().unwrap_or_default();
+                self.state.partial = Some(progress.clone());
+                let written = self.save(&dir.join(MID_EPOCH_CHECKPOINT));
+                self.state.partial = None;
+                written?;
                 saved = Instant::now();
             }
         }
-        Ok(progress)
+        Ok(())
     }
 
     /// Evaluates the network (without autodiff) on `batches`; averages over samples.

@@ -889,6 +889,23 @@ fn an_epoch_stopped_inside_resumes_where_it_stopped() {
     let state = load_checkpoint(&mid).unwrap().state;
     assert_eq!((state.epoch, state.step), (1, 6));
     assert_eq!(state.partial.as_ref().map(|p| p.batches), Some(2));
+    // The stopped trainer itself goes on from there too.
+    assert_eq!(stopped.state().partial, state.partial);
+    let same_trainer = tempfile::tempdir().unwrap();
+    stopped
+        .fit(
+            2,
+            |_, skip| batches(skip),
+            NO_VALIDATION,
+            same_trainer.path(),
+            |_| {},
+        )
+        .unwrap();
+    let (whole_last, _, _) = Trainer::output_paths(whole.path());
+    assert_eq!(
+        checkpoint_params(&same_trainer.path().join("last.garnet"), &device),
+        checkpoint_params(&whole_last, &device)
+    );
     // A network made from it (an average, a grown one) begins its next epoch afresh.
     let made = dir.path().join("made");
     std::fs::create_dir(&made).unwrap();
@@ -942,7 +959,6 @@ fn an_epoch_stopped_inside_resumes_where_it_stopped() {
     assert_eq!(rest[0].train_samples, 4);
     assert!(!mid.exists());
     let (last, _, _) = Trainer::output_paths(dir.path());
-    let (whole_last, _, _) = Trainer::output_paths(whole.path());
     assert_eq!(
         Trainer::resume_point(dir.path()).unwrap(),
         Some(last.clone())
