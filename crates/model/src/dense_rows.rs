@@ -166,7 +166,12 @@ pub fn run_chain(
                     .map(move |(t, dst)| {
                         let tile = run_tile(s, t);
                         dst.copy_from_slice(&tile);
-                        column_max(&tile)
+                        // Only when the pooling is asked for (empty otherwise).
+                        if max {
+                            column_max(&tile)
+                        } else {
+                            Vec::new()
+                        }
                     })
             })
             .collect();
