@@ -12,6 +12,8 @@ DIR/MODEL/samples.csv), read against the dataset's manifest. Needs numpy (and sc
   drape_errors.py contact DRAPES           the error along and across the body normal, and
                                            E_dist with each vertex's clearance from the skin
                                            made exact (the ceiling of a contact correction)
+  drape_errors.py smooth  DRAPES           E_dist with the predicted displacement from M
+                                           smoothed over the mesh, 1 to 16 iterations
 """
 import csv
 import glob
@@ -102,14 +104,19 @@ def shrink(drapes):
         print(f'displacement scaled by {scale:.2f}: E_dist {np.mean(e):.4f} cm')
 
 
-def scales(drapes):
+def ring_mean(drapes):
+    """The garment's 1-ring mean as a sparse [N, N] matrix (row i averages i's neighbours)."""
     import scipy.sparse as sp
     _, faces = read_ply(drapes.dir + f"{int(drapes.rows[0]['index']):06d}-sim.ply", True)
     n = faces.max() + 1
     edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
     edges = np.unique(np.concatenate([edges, edges[:, ::-1]]), axis=0)
     ring = sp.csr_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(n, n))
-    ring = sp.diags(1 / np.asarray(ring.sum(1)).ravel()) @ ring
+    return sp.diags(1 / np.asarray(ring.sum(1)).ravel()) @ ring
+
+
+def scales(drapes):
+    ring = ring_mean(drapes)
     marks = (5, 20, 80, 320)
     parts = {m: [] for m in marks}
     for _, net, sim, _ in drapes.each():
@@ -202,8 +209,31 @@ def contact(drapes, near=0.02):
           f'{a[4]:.3f} cm')
 
 
+def smooth(drapes, weights=(0.25, 0.5)):
+    """E_dist with the network's displacement from M (net - dqs) smoothed over the mesh by 1
+    to 16 iterations, each moving a vertex's displacement the given weight of the way to its
+    1-ring's mean: does the prediction carry high-frequency noise that the labels lack?"""
+    ring = ring_mean(drapes)
+    marks = (1, 2, 4, 8, 16)
+    res = {(w, m): [] for w in weights for m in marks}
+    raw = []
+    for _, net, sim, dqs in drapes.each():
+        raw.append(mean_dist_cm(net, sim))
+        for w in weights:
+            d, done = net - dqs, 0
+            for m in marks:
+                while done < m:
+                    d, done = (1 - w) * d + w * (ring @ d), done + 1
+                res[(w, m)].append(mean_dist_cm(dqs + d, sim))
+    print(f'{len(raw)} drapes: E_dist {np.mean(raw):.4f} cm as predicted')
+    for w in weights:
+        print(f'weight {w}: ' + ', '.join(f'{m} iterations {np.mean(res[(w, m)]):.4f}'
+                                          for m in marks))
+
+
 if __name__ == '__main__':
-    commands = {'by-stat': by_stat, 'shrink': shrink, 'scales': scales, 'contact': contact}
+    commands = {'by-stat': by_stat, 'shrink': shrink, 'scales': scales, 'contact': contact,
+                'smooth': smooth}
     if len(sys.argv) == 4 and sys.argv[1] == 'regions':
         regions(Drapes(sys.argv[2]), sys.argv[3])
     elif len(sys.argv) >= 3 and sys.argv[1] in commands:

@@ -2,8 +2,8 @@
 # Makes a dataset's drapes one slot block at a time, so that whatever is done when a session
 # ends is balanced over the bodies: block k is shard BASE + STRIDE * b + k for every body b
 # of SPLIT (each shard holding one block of a body's poses). Resumable: run it again and
-# `dataset generate` skips what is made. The split's bodies come from OUT's manifest, else
-# from out/standard-x9-t99-lbs's (every x9 spec has the same 600 bodies and splits). Runs
+# `dataset generate` skips what is made. The split's bodies come from OUT's manifest, which a
+# new folder gets from `dataset generate --max-samples 0` before any drape is made. Runs
 # ./target/release/garnet; usage, from the repository root:
 #   nohup scripts/slot_blocks.sh SPEC OUT BASE STRIDE SPLIT JOBS BLOCK... > LOG 2>&1 &
 # The T-shirts of standard-x9-t99-lbs's training bodies (t81's slots 0-80 are blocks 0-8,
@@ -23,7 +23,8 @@ fi
 SPEC=$1 OUT=$2 BASE=$3 STRIDE=$4 SPLIT=$5 JOBS=$6
 shift 6
 MANIFEST=$OUT/manifest.json
-[ -f "$MANIFEST" ] || MANIFEST=out/standard-x9-t99-lbs/manifest.json
+# A new folder gets its manifest (and with it the splits) before any drape is made.
+[ -f "$MANIFEST" ] || ./target/release/garnet dataset generate "$SPEC" --out "$OUT" --max-samples 0
 for k in "$@"; do
   SHARDS=$(python3 -c "import json, sys
 m = json.load(open(sys.argv[1]))
