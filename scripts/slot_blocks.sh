@@ -10,6 +10,9 @@
 # the fresh slots 81-98 blocks 9-10; docs/model.md "Remaking t81 into t99"):
 #   scripts/slot_blocks.sh specs/standard-x9-t99-lbs.toml out/standard-x9-t99-lbs 0 11 \
 #     train 2 0 1 2 3 4 5 6 7 8
+# and its 900 validation T-shirts (slots 0-44 of the validation bodies):
+#   scripts/slot_blocks.sh specs/standard-x9-t99-lbs.toml out/standard-x9-t99-lbs 0 11 \
+#     val 2 0 1 2 3 4
 # The sweaters of standard-x9-sw54-lbs (training blocks 0-5, then validation blocks 0-2):
 #   scripts/slot_blocks.sh specs/standard-x9-sw54-lbs.toml out/standard-x9-sw54-lbs 2400 6 \
 #     train 2 0 1 2 3 4 5
@@ -17,7 +20,7 @@
 #     val 2 0 1 2
 set -e
 if [ $# -lt 7 ]; then
-  sed -n '2,17p' "$0" >&2
+  sed -n '2,20p' "$0" >&2
   exit 2
 fi
 SPEC=$1 OUT=$2 BASE=$3 STRIDE=$4 SPLIT=$5 JOBS=$6
