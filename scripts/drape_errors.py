@@ -209,7 +209,7 @@ def contact(drapes, near=0.02):
           f'{a[4]:.3f} cm')
 
 
-def smooth(drapes, weights=(0.25, 0.5)):
+def smooth(drapes, weights=(0.05, 0.1, 0.25, 0.5)):
     """E_dist with the network's displacement from M (net - dqs) smoothed over the mesh by 1
     to 16 iterations, each moving a vertex's displacement the given weight of the way to its
     1-ring's mean: does the prediction carry high-frequency noise that the labels lack?"""

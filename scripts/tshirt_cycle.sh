@@ -5,12 +5,13 @@
 # to 1e-6, batch 1 on one thread, every epoch kept. Resumable: run it again and it goes on
 # from DIR's mid-epoch or last checkpoint. Run it once per core with another seed, from the
 # repository root, once every block of t99's training split is made (scripts/slot_blocks.sh):
+#   mkdir -p out/runs
 #   nohup scripts/tshirt_cycle.sh 4 out/runs/tshirt-c9  >> out/runs/tshirt-c9.log 2>&1 &
 #   nohup scripts/tshirt_cycle.sh 5 out/runs/tshirt-c9b >> out/runs/tshirt-c9b.log 2>&1 &
 # then judge both with scripts/judge_tshirt_cycle.sh.
 set -e
 if [ $# -ne 2 ]; then
-  sed -n '2,10p' "$0" >&2
+  sed -n '2,11p' "$0" >&2
   exit 2
 fi
 SEED=$1 DIR=$2
