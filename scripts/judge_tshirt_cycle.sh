@@ -8,7 +8,7 @@
 #   scripts/judge_tshirt_cycle.sh out/runs/tshirt-c9 out/runs/tshirt-c9b
 set -e
 if [ $# -ne 2 ]; then
-  sed -n '2,8p' "$0" >&2
+  sed -n '2,/^[^#]/{/^#/p}' "$0" >&2
   exit 2
 fi
 A=$1 B=$2

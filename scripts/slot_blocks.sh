@@ -20,7 +20,7 @@
 #     val 2 0 1 2
 set -e
 if [ $# -lt 7 ]; then
-  sed -n '2,20p' "$0" >&2
+  sed -n '2,/^[^#]/{/^#/p}' "$0" >&2
   exit 2
 fi
 SPEC=$1 OUT=$2 BASE=$3 STRIDE=$4 SPLIT=$5 JOBS=$6

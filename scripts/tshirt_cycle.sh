@@ -11,7 +11,7 @@
 # then judge both with scripts/judge_tshirt_cycle.sh.
 set -e
 if [ $# -ne 2 ]; then
-  sed -n '2,11p' "$0" >&2
+  sed -n '2,/^[^#]/{/^#/p}' "$0" >&2
   exit 2
 fi
 SEED=$1 DIR=$2
