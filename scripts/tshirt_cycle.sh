@@ -1,8 +1,8 @@
 #!/bin/bash
 # The T-shirt's next cycle (docs/model.md "The T-shirt's cycle on t99, two seeds"): two
-# epochs on all of standard-x9-t99-lbs's training T-shirts from the shipped T-shirt (its
-# file records 124 epochs, also since session 50 shipped the mean of this cycle's epoch 125
-# and its start; a model file has no optimiser state, so Adam starts afresh), 5.5e-6 along a cosine
+# epochs on all of standard-x9-t99-lbs's training T-shirts from the shipped T-shirt (whose
+# file records 124 epochs, before and since session 50 shipped this cycle's first epoch; a
+# model file has no optimiser state, so Adam starts afresh), 5.5e-6 along a cosine
 # to 1e-6, batch 1 on one thread, every epoch kept. Resumable: run it again and it goes on
 # from DIR's mid-epoch or last checkpoint. Run it once per core with another seed, from the
 # repository root, once every block of t99's training split is made (scripts/slot_blocks.sh):
