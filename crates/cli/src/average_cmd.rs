@@ -36,8 +36,14 @@ pub fn run(args: &AverageArgs) -> anyhow::Result<()> {
     }
     let inputs: Vec<&Path> = args.models.iter().map(PathBuf::as_path).collect();
     let command = crate::output::command_line();
-    let report = model::average_checkpoints(&inputs, args.weights.as_deref(), &args.out, &command)
-        .with_context(|| format!("averaging into {}", args.out.display()))?;
+    let report = model::average_checkpoints(
+        &inputs,
+        args.weights.as_deref(),
+        &args.out,
+        &command,
+        crate::train_drapes::training_drapes,
+    )
+    .with_context(|| format!("averaging into {}", args.out.display()))?;
     let what = match &args.weights {
         Some(w) => format!("the combination with weights {w:?}"),
         None => "the mean".to_string(),

@@ -1,7 +1,7 @@
 //! `--at-rest` and `--max-strain PCT`: which drapes of a dataset `train` and `eval` use.
 
-use anyhow::bail;
-use clap::Args;
+use anyhow::{bail, Context};
+use clap::{Args, Parser};
 use dataset::{Dataset, DrapeFilter};
 
 /// Leave poor labels out: drapes that never came to rest, whose garment was stretched far
@@ -54,6 +54,21 @@ pub fn filter_flags(filter: &DrapeFilter) -> String {
     flags
 }
 
+/// The filter whose flags [`filter_flags`] wrote as `flags` (`None` for `""`: every
+/// drape); errors, quoting them, on flags it does not take.
+pub fn parse_filter_flags(flags: &str) -> anyhow::Result<Option<DrapeFilter>> {
+    /// The filter's flags alone on a command line.
+    #[derive(Parser)]
+    struct FilterLine {
+        #[command(flatten)]
+        drapes: DrapeFilterArgs,
+    }
+    let line =
+        FilterLine::try_parse_from(std::iter::once("filter").chain(flags.split_whitespace()))
+            .with_context(|| format!("reading the drape filter flags '{flags}'"))?;
+    line.drapes.filter()
+}
+
 /// Keeps in `indices` (the `garment` samples of `split` in `data`) only the drapes `filter`
 /// passes; returns how many were dropped. Errors, naming the dataset and the filter, when
 /// none is left.
@@ -91,5 +106,13 @@ mod tests {
         let f = args.filter().unwrap().unwrap();
         assert_eq!(filter_flags(&f), " --at-rest --max-strain 5 --max-slide 10");
         assert_eq!(DrapeFilterArgs::default().filter().unwrap(), None);
+        // And back again.
+        assert_eq!(parse_filter_flags(&filter_flags(&f)).unwrap(), Some(f));
+        assert_eq!(parse_filter_flags("").unwrap(), None);
+        let err = parse_filter_flags(" --max-strain 5 --seed 3").unwrap_err();
+        assert!(
+            format!("{err:#}").contains("' --max-strain 5 --seed 3'"),
+            "{err:#}"
+        );
     }
 }

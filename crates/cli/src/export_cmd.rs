@@ -13,7 +13,7 @@ use model::{load_checkpoint, save_checkpoint, Checkpoint};
 
 use dataset::{Dataset, DrapeFilter};
 
-use crate::drape_filter_args::{filter_flags, DrapeFilterArgs};
+use crate::drape_filter_args::{filter_flags, parse_filter_flags, DrapeFilterArgs};
 use crate::eval_cmd::{EvalData, EvalOutputs, ModelEvaluation};
 use crate::model_device::DeviceArg;
 
@@ -44,7 +44,7 @@ pub struct ExportArgs {
     /// A filter of drapes (`garnet train`'s flags): the card counts the training drapes that
     /// pass it and adds the metrics on the test drapes that pass it. What the model trained
     /// on each epoch comes from its run's `metrics.csv` beside `--model` where there is one,
-    /// else the card takes it to be these drapes.
+    /// else from the training drapes the checkpoint records (see `garnet average`).
     #[command(flatten)]
     pub drapes: DrapeFilterArgs,
 }
@@ -148,26 +148,41 @@ fn model_card(
     let loss = &ck.loss;
     let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("model");
     let size_mb = std::fs::metadata(path)?.len() as f64 / 1e6;
-    let mut train_indices = train.select(Some("train"), Some(&eval.garment))?;
-    let train_all = train_indices.len();
+    let train_indices = train.select(Some("train"), Some(&eval.garment))?;
+    let passing = |f: &DrapeFilter| {
+        let mut kept = train_indices.clone();
+        train.retain_drapes(&mut kept, f);
+        kept.len()
+    };
     // What the run trained on, from its log where there is one: a model fine-tuned from
     // another on other drapes has its own count per epoch, whatever the export's filter.
+    // Else from the checkpoint's record: the export's filter only chooses the card's rows.
     let metrics_csv = source
         .parent()
         .map(|d| d.join(model::trainer::METRICS_LOG))
         .and_then(|m| std::fs::read_to_string(m).ok());
-    let samples_history = metrics_csv.as_deref().and_then(training_samples_history);
-    let mut trained_on = format!("{train_all} training samples of this garment");
-    if let Some((f, _)) = filtered {
-        train.retain_drapes(&mut train_indices, f);
-        let (n, drapes) = (train_indices.len(), f.describe());
-        trained_on += &match samples_history {
-            None => format!(", trained on the {n} of them that are {drapes}"),
-            Some(_) => format!(", {n} of them {drapes}"),
-        };
-    }
-    if let Some(h) = &samples_history {
-        trained_on += &format!("; samples trained on per epoch (from the run's metrics.csv): {h}");
+    let mut trained_on = format!("{} training samples of this garment", train_indices.len());
+    match metrics_csv.as_deref().and_then(training_samples_history) {
+        Some(history) => {
+            if let Some((f, _)) = filtered {
+                trained_on += &format!(", {} of them {}", passing(f), f.describe());
+            }
+            trained_on +=
+                &format!("; samples trained on per epoch (from the run's metrics.csv): {history}");
+        }
+        None => match crate::train_drapes::training_drapes(&ck.state) {
+            None => trained_on += "; the drapes it trained on are not recorded in the checkpoint",
+            Some(flags) => match parse_filter_flags(&flags)? {
+                None => trained_on += ", trained on every one of them",
+                Some(f) => {
+                    trained_on += &format!(
+                        ", trained on the {} of them that are {}",
+                        passing(&f),
+                        f.describe()
+                    )
+                }
+            },
+        },
     }
     let [net, dqs] = eval.summary();
     let (net_ms, sim_s) = eval.times();
@@ -189,8 +204,8 @@ fn model_card(
          - dataset: '{ds}' (`{dir}`, spec `{dir}/spec.toml`), {train}; validation on its \
          'val' split\n\
          - command: `{cmd}`\n\
-         - progress: {ep} epochs, {st} steps, last learning rate {lr:.1e}; best validation E_dist \
-         {best}\n\
+         - progress: {progress}{ep} epochs, {st} steps, last learning rate {lr:.1e}; best \
+         validation E_dist {best}\n\
          - loss: {vertex}L_vertex (mean of {vertex_name}) + {pen} L_pen + {norm} L_norm + {bend} L_bend, lengths in \
          {unit}, d_tol {dtol} m\n{vertex_history}{clip}{mirror}{history}\n",
         train = trained_on,
@@ -200,6 +215,14 @@ fn model_card(
             .command
             .as_deref()
             .unwrap_or("(not recorded in the checkpoint)"),
+        progress = if state.averaged_epochs.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "the networks averaged are of {}; the file records the last one's progress: ",
+                epoch_list(&state.averaged_epochs)
+            )
+        },
         ep = state.epoch,
         st = state.step,
         lr = state.lr,

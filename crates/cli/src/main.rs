@@ -26,6 +26,7 @@ mod shape_args;
 mod simulate_cmd;
 mod simulate_sheet;
 mod train_cmd;
+mod train_drapes;
 
 use clap::{Parser, Subcommand};
 

@@ -16,7 +16,7 @@ use model::{
     PAPER_LEARNING_RATE,
 };
 
-use crate::drape_filter_args::{keep_drapes, DrapeFilterArgs};
+use crate::drape_filter_args::{filter_flags, keep_drapes, DrapeFilterArgs};
 use crate::log_lines::{LogLines, LOG_EVERY};
 use crate::model_device::DeviceArg;
 
@@ -258,8 +258,9 @@ pub fn network_config(path: &Path, variant: Variant) -> anyhow::Result<GarNetCon
 pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
     let data = Dataset::open(&args.data)?;
     let mut train = GarmentSplit::new(&data, "train", &args.garment)?;
-    if let Some(filter) = args.drapes.filter()? {
-        let dropped = keep_drapes(&data, "train", &args.garment, &mut train.indices, &filter)?;
+    let filter = args.drapes.filter()?;
+    if let Some(filter) = &filter {
+        let dropped = keep_drapes(&data, "train", &args.garment, &mut train.indices, filter)?;
         eprintln!(
             "training on {} only: left out {dropped} training drapes",
             filter.describe()
@@ -378,6 +379,7 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
     trainer.set_checkpoint_every(checkpoint_every);
     trainer.set_training_set(&training_set_name(&data, &train.indices, args));
     trainer.set_command(crate::output::command_line());
+    trainer.set_train_drapes(filter.map_or(String::new(), |f| filter_flags(&f)));
     let params = trainer.model().num_params();
     eprintln!(
         "training {} ({params} parameters) on {} '{}' samples ({} validation), \

@@ -631,16 +631,25 @@ fn average_writes_a_checkpoint_that_exports() {
         assert_eq!(md.matches(&row).count(), 3, "{row}\n{md}");
     }
     assert_eq!(md.matches("| tshirt | DQS |").count(), 1, "{md}");
+    // The export's filter only adds the card's rows on the test drapes it passes: the
+    // mean (no metrics.csv beside it) trained on every drape, as its record says (a
+    // regression: the card said it trained only on the drapes the export's filter passes).
     let card = exported_card(
         &mean,
         data,
         &tmp.path().join("models").join("tshirt-naive.garnet"),
+        &["--max-strain", "1000"],
     );
-    assert!(
-        card.contains("- weights: the mean of the networks of epochs 1-2 (`garnet average`)")
-            && card.contains("; then garnet average --models"),
-        "{card}"
-    );
+    for needle in [
+        "- weights: the mean of the networks of epochs 1-2 (`garnet average`)",
+        "; then garnet average --models",
+        "2 training samples of this garment, trained on every one of them; validation",
+        "- progress: the networks averaged are of epochs 1-2; the file records the last one's \
+         progress: 2 epochs",
+        "| GarNet-naive, drapes with strain p99 at most 1000% |",
+    ] {
+        assert!(card.contains(needle), "{needle} missing:\n{card}");
+    }
 
     let local = one_epoch_checkpoint(data, "local", &tmp.path().join("local"));
     let err = fails(&[
@@ -680,6 +689,7 @@ fn average_writes_a_checkpoint_that_exports() {
         &combined,
         data,
         &tmp.path().join("models").join("tshirt-naive-x.garnet"),
+        &[],
     );
     assert!(
         card.contains("the combination -0.5 x epoch 1 + 1.5 x epoch 2 of networks"),
@@ -700,10 +710,10 @@ fn average_writes_a_checkpoint_that_exports() {
     assert!(!bad.exists());
 }
 
-/// Exports `model` as `out` with `data`'s test metrics and returns the model card written
-/// beside it.
-fn exported_card(model: &Path, data: &Path, out: &Path) -> String {
-    ok(&[
+/// Exports `model` as `out` with `data`'s test metrics and the drape filter flags `filter`,
+/// and returns the model card written beside it.
+fn exported_card(model: &Path, data: &Path, out: &Path, filter: &[&str]) -> String {
+    let mut args = vec![
         "export",
         "--model",
         s(model),
@@ -711,7 +721,9 @@ fn exported_card(model: &Path, data: &Path, out: &Path) -> String {
         s(data),
         "--out",
         s(out),
-    ]);
+    ];
+    args.extend_from_slice(filter);
+    ok(&args);
     std::fs::read_to_string(out.with_extension("md")).unwrap()
 }
 

@@ -182,12 +182,14 @@ pub struct AverageReport {
 /// combination instead of the plain mean. The written
 /// progress is the last input's, without a best validation figure nor an epoch stopped
 /// inside (a run from it begins its next epoch afresh), and its command is the last input's
-/// followed by `command`.
+/// followed by `command`. Its training drapes ([`TrainState::train_drapes`]) are the ones
+/// `train_drapes` reads from every input's progress when they all agree, else unrecorded.
 pub fn average_checkpoints(
     inputs: &[&Path],
     weights: Option<&[f64]>,
     out: &Path,
     command: &str,
+    train_drapes: impl Fn(&TrainState) -> Option<String>,
 ) -> Result<AverageReport> {
     if inputs.len() < 2 {
         return Err(ModelError::InvalidInput(format!(
@@ -201,6 +203,7 @@ pub fn average_checkpoints(
     let device = Device::flex();
     let mut networks = Vec::with_capacity(inputs.len());
     let mut epochs = Vec::with_capacity(inputs.len());
+    let mut drapes = Vec::with_capacity(inputs.len());
     let mut reference: Option<(ModelSetup, LossConfig, TrainState)> = None;
     for path in inputs {
         let ck = load_checkpoint(path)?;
@@ -224,6 +227,7 @@ pub fn average_checkpoints(
         }
         networks.push(ck.model(&device)?);
         epochs.push(ck.state.epoch);
+        drapes.push(train_drapes(&ck.state));
         reference = Some((ck.setup, ck.loss, ck.state));
     }
     let (setup, loss, mut state) = reference.expect("at least two inputs");
@@ -237,6 +241,9 @@ pub fn average_checkpoints(
     state.averaged_weights = weights.map(<[f64]>::to_vec).unwrap_or_default();
     // Not the network any epoch stopped in: a run from it begins its next epoch afresh.
     state.partial = None;
+    state.train_drapes = drapes[0]
+        .clone()
+        .filter(|_| drapes.windows(2).all(|w| w[0] == w[1]));
     state.append_command(command);
     save_checkpoint(out, &mean, None, &setup, &loss, &state)?;
     Ok(AverageReport {

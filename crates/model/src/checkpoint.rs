@@ -218,6 +218,12 @@ pub struct TrainState {
     /// The command line of the latest training run (for model cards), when it was given.
     #[serde(default)]
     pub command: Option<String>,
+    /// The flags of the latest training run that chose its training drapes (`garnet
+    /// train`'s `--at-rest`, `--max-strain`, `--max-slide`, as `" --at-rest"`), `""` when it
+    /// trained on every drape; `None` where not recorded (a checkpoint written before the
+    /// field existed, or the mean of networks that trained on different drapes).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub train_drapes: Option<String>,
     /// Joint L2 norm the gradients are clipped to (`None`: no clipping).
     #[serde(default)]
     pub max_grad_norm: Option<f32>,

@@ -206,6 +206,12 @@ impl Trainer {
         self.state.command = Some(command);
     }
 
+    /// Records the flags that chose this run's training drapes (`""`: every drape; see
+    /// [`TrainState::train_drapes`]) in the checkpoints it writes.
+    pub fn set_train_drapes(&mut self, flags: String) {
+        self.state.train_drapes = Some(flags);
+    }
+
     /// Names this run's validation set (say `standard-x3-lbs:tshirt:240`). A best validation
     /// E_dist that the checkpoint says was measured on another set does not compare with
     /// this run's: it is cleared, so the next validated epoch writes `best.garnet`, and

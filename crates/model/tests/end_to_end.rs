@@ -910,7 +910,14 @@ fn an_epoch_stopped_inside_resumes_where_it_stopped() {
     let made = dir.path().join("made");
     std::fs::create_dir(&made).unwrap();
     let mean = made.join("mean.garnet");
-    average_checkpoints(&[&mid, &mid], None, &mean, "garnet average").unwrap();
+    average_checkpoints(
+        &[&mid, &mid],
+        None,
+        &mean,
+        "garnet average",
+        recorded_drapes,
+    )
+    .unwrap();
     let grown = made.join("grown.garnet");
     let plan = GrowPlan {
         extra_blocks: 1,
@@ -1005,6 +1012,12 @@ fn global_trainer_on_two_samples(device: &Device) -> (Trainer, Vec<Sample>) {
     )
 }
 
+/// The training drapes a checkpoint's progress records, as `garnet average` is told to read
+/// them.
+fn recorded_drapes(state: &TrainState) -> Option<String> {
+    state.train_drapes.clone()
+}
+
 /// The parameter values of the network in the checkpoint at `path`.
 fn checkpoint_params(path: &std::path::Path, device: &Device) -> Vec<model::average::ParamValues> {
     model::average::parameter_values(&load_checkpoint(path).unwrap().model(device).unwrap())
@@ -1020,6 +1033,7 @@ fn averaged_checkpoint_holds_the_mean_network() {
     let (mut trainer, data) = global_trainer_on_two_samples(&device);
     let train = || vec![Ok::<_, String>(data.clone())];
     trainer.set_command("garnet train x".into());
+    trainer.set_train_drapes(" --at-rest".into());
     trainer.set_keep_epochs(true);
     trainer
         .fit(3, |_, _| train(), NO_VALIDATION, dir.path(), |_| {})
@@ -1029,7 +1043,8 @@ fn averaged_checkpoint_holds_the_mean_network() {
         .collect();
     let inputs: Vec<&std::path::Path> = snapshots.iter().map(|p| p.as_path()).collect();
     let out = dir.path().join("mean.garnet");
-    let report = average_checkpoints(&inputs, None, &out, "garnet average").unwrap();
+    let report =
+        average_checkpoints(&inputs, None, &out, "garnet average", recorded_drapes).unwrap();
     assert_eq!(report.epochs, vec![1, 2, 3]);
     let mean = load_checkpoint(&out).unwrap();
     assert!(!mean.has_optimizer());
@@ -1042,6 +1057,22 @@ fn averaged_checkpoint_holds_the_mean_network() {
         .as_deref()
         .unwrap()
         .ends_with("; then garnet average"));
+    // Inputs that trained on the same drapes pass them on; inputs that disagree leave them
+    // unrecorded.
+    assert_eq!(mean.state.train_drapes.as_deref(), Some(" --at-rest"));
+    let by_epoch = |s: &TrainState| Some(format!("epoch {}", s.epoch.min(2)));
+    let partly = dir.path().join("partly.garnet");
+    average_checkpoints(&inputs[..2], None, &partly, "x", by_epoch).unwrap();
+    assert_eq!(load_checkpoint(&partly).unwrap().state.train_drapes, None);
+    average_checkpoints(&inputs[1..], None, &partly, "x", by_epoch).unwrap();
+    assert_eq!(
+        load_checkpoint(&partly)
+            .unwrap()
+            .state
+            .train_drapes
+            .as_deref(),
+        Some("epoch 2")
+    );
     let nets: Vec<GarNet> = inputs
         .iter()
         .map(|p| load_checkpoint(p).unwrap().model(&device).unwrap())
@@ -1053,24 +1084,31 @@ fn averaged_checkpoint_holds_the_mean_network() {
 
     // Weights give the weighted combination; weights that do not sum to 1 are refused.
     let weights = [0.25, -0.25, 1.0];
-    average_checkpoints(&inputs, Some(&weights), &out, "garnet average").unwrap();
+    average_checkpoints(
+        &inputs,
+        Some(&weights),
+        &out,
+        "garnet average",
+        recorded_drapes,
+    )
+    .unwrap();
     let expected = combine_networks(&nets, &weights).unwrap();
     assert_eq!(
         checkpoint_params(&out, &device),
         model::average::parameter_values(&expected).unwrap()
     );
-    let err = average_checkpoints(&inputs, Some(&[0.5, 0.5, 0.5]), &out, "x")
+    let err = average_checkpoints(&inputs, Some(&[0.5, 0.5, 0.5]), &out, "x", recorded_drapes)
         .unwrap_err()
         .to_string();
     assert!(err.contains("sum to"), "{err}");
 
     // One input, or inputs of another garment template, are refused.
-    assert!(average_checkpoints(&inputs[..1], None, &out, "x").is_err());
+    assert!(average_checkpoints(&inputs[..1], None, &out, "x", recorded_drapes).is_err());
     let other = dir.path().join("other.garnet");
     let s2 = setup(Variant::Global, 90);
     let t2 = Trainer::new(s2, LossConfig::new(), 1e-3, &device).unwrap();
     t2.save(&other).unwrap();
-    let err = average_checkpoints(&[inputs[0], &other], None, &out, "x")
+    let err = average_checkpoints(&[inputs[0], &other], None, &out, "x", recorded_drapes)
         .unwrap_err()
         .to_string();
     assert!(err.contains("not averageable"), "{err}");
