@@ -170,18 +170,19 @@ fn model_card(
             trained_on +=
                 &format!("; samples trained on per epoch (from the run's metrics.csv): {history}");
         }
-        None => match crate::train_drapes::training_drapes(&ck.state) {
+        // Flags that no longer parse (a checkpoint of another version) read as unrecorded.
+        None => match crate::train_drapes::training_drapes(&ck.state)
+            .and_then(|flags| parse_filter_flags(&flags).ok())
+        {
             None => trained_on += "; the drapes it trained on are not recorded in the checkpoint",
-            Some(flags) => match parse_filter_flags(&flags)? {
-                None => trained_on += ", trained on every one of them",
-                Some(f) => {
-                    trained_on += &format!(
-                        ", trained on the {} of them that are {}",
-                        passing(&f),
-                        f.describe()
-                    )
-                }
-            },
+            Some(None) => trained_on += ", trained on every one of them",
+            Some(Some(f)) => {
+                trained_on += &format!(
+                    ", trained on the {} of them that are {}",
+                    passing(&f),
+                    f.describe()
+                )
+            }
         },
     }
     let [net, dqs] = eval.summary();
