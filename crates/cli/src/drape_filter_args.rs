@@ -39,9 +39,13 @@ impl DrapeFilterArgs {
     }
 }
 
-/// The command-line flags that give `filter`, each after a space (" --at-rest --max-strain 5").
-pub fn filter_flags(filter: &DrapeFilter) -> String {
+/// The command-line flags that give `filter`, each after a space (" --at-rest --max-strain 5");
+/// `""` for no filter (every drape).
+pub fn filter_flags(filter: Option<&DrapeFilter>) -> String {
     let mut flags = String::new();
+    let Some(filter) = filter else {
+        return flags;
+    };
     if filter.at_rest {
         flags += " --at-rest";
     }
@@ -104,10 +108,16 @@ mod tests {
             max_slide: Some(10.0),
         };
         let f = args.filter().unwrap().unwrap();
-        assert_eq!(filter_flags(&f), " --at-rest --max-strain 5 --max-slide 10");
+        assert_eq!(
+            filter_flags(Some(&f)),
+            " --at-rest --max-strain 5 --max-slide 10"
+        );
         assert_eq!(DrapeFilterArgs::default().filter().unwrap(), None);
         // And back again.
-        assert_eq!(parse_filter_flags(&filter_flags(&f)).unwrap(), Some(f));
+        assert_eq!(
+            parse_filter_flags(&filter_flags(Some(&f))).unwrap(),
+            Some(f)
+        );
         assert_eq!(parse_filter_flags("").unwrap(), None);
         let err = parse_filter_flags(" --max-strain 5 --seed 3").unwrap_err();
         assert!(

@@ -307,7 +307,7 @@ fn model_card(
             format!(" --train-data {}", train.dir().display())
         },
         path.display(),
-        filtered.map_or(String::new(), |(f, _)| filter_flags(f))
+        filter_flags(filtered.map(|(f, _)| f))
     );
     Ok(md)
 }

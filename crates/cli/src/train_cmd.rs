@@ -379,7 +379,7 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
     trainer.set_checkpoint_every(checkpoint_every);
     trainer.set_training_set(&training_set_name(&data, &train.indices, args));
     trainer.set_command(crate::output::command_line());
-    trainer.set_train_drapes(filter.map_or(String::new(), |f| filter_flags(&f)));
+    trainer.set_train_drapes(filter_flags(filter.as_ref()));
     let params = trainer.model().num_params();
     eprintln!(
         "training {} ({params} parameters) on {} '{}' samples ({} validation), \

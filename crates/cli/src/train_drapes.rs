@@ -30,7 +30,7 @@ pub fn training_drapes(state: &TrainState) -> Option<String> {
         .find(|c| c.starts_with("garnet train "))?;
     let line = TrainLine::try_parse_from(train.split_whitespace().skip(1)).ok()?;
     let filter = line.args.drapes.filter().ok()?;
-    Some(filter.map_or(String::new(), |f| filter_flags(&f)))
+    Some(filter_flags(filter.as_ref()))
 }
 
 #[cfg(test)]
