@@ -14,6 +14,14 @@ DIR/MODEL/samples.csv), read against the dataset's manifest. Needs numpy (and sc
                                            made exact (the ceiling of a contact correction)
   drape_errors.py smooth  DRAPES           E_dist with the predicted displacement from M
                                            smoothed over the mesh, 1 to 16 iterations
+  drape_errors.py noise DATASET DRAPES OTHER...
+                                           how much of E_dist is the labels' own spread: OTHER
+                                           are the same model's drapes of the same samples
+                                           simulated again with a negligible change (say the
+                                           cloth 0.1% heavier); the network against each label
+                                           set and their mean, the labels against each other,
+                                           and the split into label spread and network error,
+                                           by motion too (DATASET's manifest names them)
 """
 import csv
 import glob
@@ -231,11 +239,64 @@ def smooth(drapes, weights=(0.05, 0.1, 0.25, 0.5)):
                                           for m in marks))
 
 
+def rms_cm(a, b):
+    return 100 * np.sqrt((np.linalg.norm(a - b, axis=1) ** 2).mean())
+
+
+def noise(drapes, others):
+    """Splits the network's error into the labels' spread and its own. With K label sets of
+    the same samples, each label the expected drape plus an independent spread s (per-vertex
+    RMS), and e the network's RMS distance from the expected drape: RMS(net, one label)^2 =
+    e^2 + s^2 and RMS(label, label)^2 = 2 s^2, so a network that drew the expected drape
+    exactly would still be s from the labels."""
+    sets = [drapes] + others
+    rows = {int(r['index']): r for r in drapes.rows}
+    common = sorted(set(rows).intersection(*({int(r['index']) for r in o.rows} for o in others)))
+    k = len(sets)
+    stats = {name: [] for name in ('net', 'net_mean', 'pair', 'net_rms', 'net_mean_rms',
+                                   'pair_rms')}
+    motions = {}
+    for index in common:
+        net = drapes.mesh(index, 'net')
+        labels = [d.mesh(index, 'sim') for d in sets]
+        mean = np.mean(labels, axis=0)
+        stats['net'].append(np.mean([mean_dist_cm(net, g) for g in labels]))
+        stats['net_rms'].append(np.mean([rms_cm(net, g) ** 2 for g in labels]))
+        stats['net_mean'].append(mean_dist_cm(net, mean))
+        stats['net_mean_rms'].append(rms_cm(net, mean) ** 2)
+        pairs = [(a, b) for i, a in enumerate(labels) for b in labels[i + 1:]]
+        stats['pair'].append(np.mean([mean_dist_cm(a, b) for a, b in pairs]))
+        stats['pair_rms'].append(np.mean([rms_cm(a, b) ** 2 for a, b in pairs]))
+        motion = drapes.samples.get(index, {}).get('pose', '?').split('#')[0]
+        motion = motion.split(':')[-1] if motion.startswith('procedural') else \
+            motion.rsplit('/', 1)[-1].replace('.amc', '')
+        motions.setdefault(motion, []).append(len(stats['net']) - 1)
+    mean = {key: np.mean(v) for key, v in stats.items()}
+    spread2 = mean['pair_rms'] / 2
+    print(f'{len(common)} drapes, {k} label sets')
+    print(f"E_dist, network to one label (mean over the sets): {mean['net']:.3f} cm")
+    print(f"E_dist, network to the mean of the {k} labels:      {mean['net_mean']:.3f} cm")
+    print(f"E_dist, label to label:                             {mean['pair']:.3f} cm")
+    print(f"per-vertex RMS: network to a label {np.sqrt(mean['net_rms']):.3f}, to the mean "
+          f"{np.sqrt(mean['net_mean_rms']):.3f}, label to label {np.sqrt(mean['pair_rms']):.3f} cm")
+    print(f"a network drawing the expected drape would score about {mean['pair'] / np.sqrt(2):.3f}"
+          f" cm E_dist (label to label / sqrt 2)")
+    print(f"label spread s {np.sqrt(spread2):.3f} cm, the network's own error e "
+          f"{np.sqrt(max(mean['net_rms'] - spread2, 0)):.3f} cm (per-vertex RMS)")
+    print('by motion: drapes, network to a label, to the mean, label to label (cm)')
+    for motion, idx in sorted(motions.items()):
+        cell = lambda key: np.mean([stats[key][i] for i in idx])
+        print(f"  {motion:18s} {len(idx):4d} {cell('net'):6.3f} {cell('net_mean'):6.3f} "
+              f"{cell('pair'):6.3f}")
+
+
 if __name__ == '__main__':
     commands = {'by-stat': by_stat, 'shrink': shrink, 'scales': scales, 'contact': contact,
                 'smooth': smooth}
     if len(sys.argv) == 4 and sys.argv[1] == 'regions':
         regions(Drapes(sys.argv[2]), sys.argv[3])
+    elif len(sys.argv) >= 5 and sys.argv[1] == 'noise':
+        noise(Drapes(sys.argv[3], sys.argv[2]), [Drapes(d) for d in sys.argv[4:]])
     elif len(sys.argv) >= 3 and sys.argv[1] in commands:
         commands[sys.argv[1]](Drapes(sys.argv[2], sys.argv[3] if len(sys.argv) > 3 else None))
     else:
