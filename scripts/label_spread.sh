@@ -38,7 +38,8 @@ for model in "$@"; do
     data=$OUT/$set; [ $set = 0 ] && data=$DATA
     drapes=$OUT/drapes-$tag-$set
     [ -d "$drapes" ] || ./target/release/garnet eval --data "$data" --split test --model "$model" \
-      --save-drapes "$drapes" --out "$drapes-eval" > /dev/null
+      --save-drapes "$drapes" --out "$drapes-eval" > "$drapes.log" 2>&1 \
+      || { cat "$drapes.log" >&2; exit 1; }
   done
   echo "== $model"
   python3 scripts/drape_errors.py noise "$DATA" "$OUT/drapes-$tag-0" "$OUT/drapes-$tag-a" \
