@@ -19,9 +19,10 @@ DIR/MODEL/samples.csv), read against the dataset's manifest. Needs numpy (and sc
                                            are the same model's drapes of the same samples
                                            simulated again with a negligible change (say the
                                            cloth 0.1% heavier); the network against each label
-                                           set and their mean, the labels against each other,
-                                           and the split into label spread and network error,
-                                           by motion too (DATASET's manifest names them)
+                                           set and their mean, the labels against each other
+                                           (E_dist and E_norm), and the split into label spread
+                                           and network error, by motion too (DATASET's
+                                           manifest names them)
 """
 import csv
 import glob
@@ -243,6 +244,14 @@ def rms_cm(a, b):
     return 100 * np.sqrt((np.linalg.norm(a - b, axis=1) ** 2).mean())
 
 
+def e_norm_deg(a, b, f):
+    """E_norm: the mean angle between the two meshes' face normals, degrees."""
+    na = np.cross(a[f[:, 1]] - a[f[:, 0]], a[f[:, 2]] - a[f[:, 0]])
+    nb = np.cross(b[f[:, 1]] - b[f[:, 0]], b[f[:, 2]] - b[f[:, 0]])
+    angle = np.arctan2(np.linalg.norm(np.cross(na, nb), axis=1), (na * nb).sum(axis=1))
+    return np.degrees(angle).mean()
+
+
 def noise(drapes, others):
     """Splits the network's error into the labels' spread and its own. With K label sets of
     the same samples, each label the expected drape plus an independent spread s (per-vertex
@@ -254,10 +263,13 @@ def noise(drapes, others):
     common = sorted(set(rows).intersection(*({int(r['index']) for r in o.rows} for o in others)))
     k = len(sets)
     stats = {name: [] for name in ('net', 'net_mean', 'pair', 'net_rms', 'net_mean_rms',
-                                   'pair_rms')}
+                                   'pair_rms', 'net_norm', 'pair_norm')}
+    faces = None
     motions = {}
     for index in common:
         net = drapes.mesh(index, 'net')
+        if faces is None:
+            faces = read_ply(f'{drapes.dir}{index:06d}-sim.ply', faces=True)[1]
         labels = [d.mesh(index, 'sim') for d in sets]
         mean = np.mean(labels, axis=0)
         stats['net'].append(np.mean([mean_dist_cm(net, g) for g in labels]))
@@ -267,6 +279,8 @@ def noise(drapes, others):
         pairs = [(a, b) for i, a in enumerate(labels) for b in labels[i + 1:]]
         stats['pair'].append(np.mean([mean_dist_cm(a, b) for a, b in pairs]))
         stats['pair_rms'].append(np.mean([rms_cm(a, b) ** 2 for a, b in pairs]))
+        stats['net_norm'].append(np.mean([e_norm_deg(g, net, faces) for g in labels]))
+        stats['pair_norm'].append(np.mean([e_norm_deg(a, b, faces) for a, b in pairs]))
         motion = drapes.samples.get(index, {}).get('pose', '?').split('#')[0]
         motion = motion.split(':')[-1] if motion.startswith('procedural') else \
             motion.rsplit('/', 1)[-1].replace('.amc', '')
@@ -277,6 +291,8 @@ def noise(drapes, others):
     print(f"E_dist, network to one label (mean over the sets): {mean['net']:.3f} cm")
     print(f"E_dist, network to the mean of the {k} labels:      {mean['net_mean']:.3f} cm")
     print(f"E_dist, label to label:                             {mean['pair']:.3f} cm")
+    print(f"E_norm, network to one label: {mean['net_norm']:.2f} degrees; label to label: "
+          f"{mean['pair_norm']:.2f}")
     print(f"per-vertex RMS: network to a label {np.sqrt(mean['net_rms']):.3f}, to the mean "
           f"{np.sqrt(mean['net_mean_rms']):.3f}, label to label {np.sqrt(mean['pair_rms']):.3f} cm")
     print(f"a network drawing the expected drape would score about {mean['pair'] / np.sqrt(2):.3f}"
