@@ -68,8 +68,13 @@ class Drapes:
             yield k, self.mesh(k, 'net'), self.mesh(k, 'sim'), self.mesh(k, 'dqs')
 
 
+def dist_cm(a, b):
+    """Per-vertex distance [N] between two meshes of one topology, cm."""
+    return 100 * np.linalg.norm(a - b, axis=1)
+
+
 def mean_dist_cm(a, b):
-    return 100 * np.linalg.norm(a - b, axis=1).mean()
+    return dist_cm(a, b).mean()
 
 
 def quartile_table(key, values, errors):
@@ -240,10 +245,6 @@ def smooth(drapes, weights=(0.05, 0.1, 0.25, 0.5)):
                                           for m in marks))
 
 
-def rms_cm(a, b):
-    return 100 * np.sqrt((np.linalg.norm(a - b, axis=1) ** 2).mean())
-
-
 def e_norm_deg(a, b, f):
     """E_norm: the mean angle between the two meshes' face normals, degrees."""
     na = np.cross(a[f[:, 1]] - a[f[:, 0]], a[f[:, 2]] - a[f[:, 0]])
@@ -252,18 +253,20 @@ def e_norm_deg(a, b, f):
     return np.degrees(angle).mean()
 
 
-def noise(drapes, others):
+def noise(drapes, others, scales=(0.5, 0.75, 0.9, 1.0)):
     """Splits the network's error into the labels' spread and its own. With K label sets of
     the same samples, each label the expected drape plus an independent spread s (per-vertex
     RMS), and e the network's RMS distance from the expected drape: RMS(net, one label)^2 =
     e^2 + s^2 and RMS(label, label)^2 = 2 s^2, so a network that drew the expected drape
-    exactly would still be s from the labels."""
+    exactly would still be s from the labels. Also E_dist with the network's error about the
+    labels' mean scaled by each of `scales` (mean + k (net - mean), each label as it is):
+    what a network with k times its own error would score."""
     sets = [drapes] + others
-    rows = {int(r['index']): r for r in drapes.rows}
-    common = sorted(set(rows).intersection(*({int(r['index']) for r in o.rows} for o in others)))
+    common = sorted(set.intersection(*({int(r['index']) for r in d.rows} for d in sets)))
     k = len(sets)
-    stats = {name: [] for name in ('net', 'net_mean', 'pair', 'net_rms', 'net_mean_rms',
-                                   'pair_rms', 'net_norm', 'pair_norm')}
+    names = ('net', 'net_mean', 'pair', 'net_rms', 'net_mean_rms', 'pair_rms', 'net_norm',
+             'pair_norm') + tuple(f'scaled {c}' for c in scales)
+    stats = {name: [] for name in names}
     faces = None
     motions = {}
     for index in common:
@@ -272,15 +275,21 @@ def noise(drapes, others):
             faces = read_ply(f'{drapes.dir}{index:06d}-sim.ply', faces=True)[1]
         labels = [d.mesh(index, 'sim') for d in sets]
         mean = np.mean(labels, axis=0)
-        stats['net'].append(np.mean([mean_dist_cm(net, g) for g in labels]))
-        stats['net_rms'].append(np.mean([rms_cm(net, g) ** 2 for g in labels]))
-        stats['net_mean'].append(mean_dist_cm(net, mean))
-        stats['net_mean_rms'].append(rms_cm(net, mean) ** 2)
+        to_label = [dist_cm(net, g) for g in labels]
+        to_mean = dist_cm(net, mean)
         pairs = [(a, b) for i, a in enumerate(labels) for b in labels[i + 1:]]
-        stats['pair'].append(np.mean([mean_dist_cm(a, b) for a, b in pairs]))
-        stats['pair_rms'].append(np.mean([rms_cm(a, b) ** 2 for a, b in pairs]))
+        between = [dist_cm(a, b) for a, b in pairs]
+        stats['net'].append(np.mean([d.mean() for d in to_label]))
+        stats['net_rms'].append(np.mean([(d ** 2).mean() for d in to_label]))
+        stats['net_mean'].append(to_mean.mean())
+        stats['net_mean_rms'].append((to_mean ** 2).mean())
+        stats['pair'].append(np.mean([d.mean() for d in between]))
+        stats['pair_rms'].append(np.mean([(d ** 2).mean() for d in between]))
         stats['net_norm'].append(np.mean([e_norm_deg(g, net, faces) for g in labels]))
         stats['pair_norm'].append(np.mean([e_norm_deg(a, b, faces) for a, b in pairs]))
+        for c in scales:
+            scaled = mean + c * (net - mean)
+            stats[f'scaled {c}'].append(np.mean([dist_cm(scaled, g).mean() for g in labels]))
         motion = drapes.samples.get(index, {}).get('pose', '?').split('#')[0]
         motion = motion.split(':')[-1] if motion.startswith('procedural') else \
             motion.rsplit('/', 1)[-1].replace('.amc', '')
@@ -299,6 +308,8 @@ def noise(drapes, others):
           f" cm E_dist (label to label / sqrt 2)")
     print(f"label spread s {np.sqrt(spread2):.3f} cm, the network's own error e "
           f"{np.sqrt(max(mean['net_rms'] - spread2, 0)):.3f} cm (per-vertex RMS)")
+    print('E_dist with the own error scaled by k: ' +
+          ', '.join(f"k {c}: {mean[f'scaled {c}']:.3f}" for c in scales) + ' cm')
     print('by motion: drapes, network to a label, to the mean, label to label (cm)')
     for motion, idx in sorted(motions.items()):
         cell = lambda key: np.mean([stats[key][i] for i in idx])
