@@ -37,7 +37,7 @@ for model in "$@"; do
   for set in 0 a b; do
     data=$OUT/$set; [ $set = 0 ] && data=$DATA
     drapes=$OUT/drapes-$tag-$set
-    [ -d "$drapes" ] || ./target/release/garnet eval --data "$data" --split test --model "$model" \
+    [ -f "$drapes-eval/results.json" ] || ./target/release/garnet eval --data "$data" --split test --model "$model" \
       --save-drapes "$drapes" --out "$drapes-eval" > "$drapes.log" 2>&1 \
       || { cat "$drapes.log" >&2; exit 1; }
   done
