@@ -1,7 +1,8 @@
 #!/bin/bash
 # Judges two runs of scripts/cycle.sh on DATA's validation split before anything touches a
 # test split: for each EPOCH given, each run's network, the mean of the two (`garnet
-# average`) and that mean with START (the network the cycle started from), and START
+# average`) and that mean with START (the network the cycle started from; left out when
+# START was trained with other loss settings, which `garnet average` refuses), and START
 # itself. Writes the means to out/hist/NAME-abEPOCH.garnet and NAME-abEPOCH-start.garnet,
 # one `garnet eval` folder per candidate under out/eval-NAME, and prints each candidate's
 # validation E_dist to four places. From the repository root:
@@ -31,10 +32,12 @@ judge start "$START"
 for E in "$@"; do
   MEAN=out/hist/$NAME-ab$E.garnet
   $G average --models "$A/epoch-$E.garnet" "$B/epoch-$E.garnet" --out "$MEAN"
-  $G average --models "$A/epoch-$E.garnet" "$B/epoch-$E.garnet" "$START" \
-    --out "out/hist/$NAME-ab$E-start.garnet"
   judge "a$E" "$A/epoch-$E.garnet"
   judge "b$E" "$B/epoch-$E.garnet"
   judge "ab$E" "$MEAN"
-  judge "ab$E-start" "out/hist/$NAME-ab$E-start.garnet"
+  # A START trained with other loss settings (the cycle switched them) is not averaged.
+  if $G average --models "$A/epoch-$E.garnet" "$B/epoch-$E.garnet" "$START" \
+    --out "out/hist/$NAME-ab$E-start.garnet"; then
+    judge "ab$E-start" "out/hist/$NAME-ab$E-start.garnet"
+  fi
 done
