@@ -55,6 +55,11 @@ pub struct TrainArgs {
     /// from) to this rate at --epochs; resuming with the same command continues the schedule.
     #[arg(long, value_name = "LR")]
     pub cosine_to: Option<f64>,
+    /// With --cosine-to: change the rate at every step instead of once an epoch, so that a
+    /// schedule of a few long epochs ends at --cosine-to (the metrics log then shows each
+    /// epoch's last rate). Part of the schedule's plan: resume with it given again.
+    #[arg(long, requires = "cosine_to")]
+    pub cosine_per_step: bool,
     /// Output folder (checkpoints `best.garnet`, `last.garnet`, `metrics.csv`); default
     /// `runs/GARMENT-VARIANT`.
     #[arg(long, value_name = "DIR")]
@@ -370,10 +375,15 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
             m.max_offset() * 1e3
         );
     }
+    let batches_per_epoch = train.indices.len().div_ceil(args.batch.max(1)) as u64;
     let schedule = args
         .cosine_to
         .map(|end| CosineSchedule::new(args.lr, end, trainer.state().epoch, args.epochs))
-        .transpose()?;
+        .transpose()?
+        .map(|s| match args.cosine_per_step {
+            true => s.per_step(batches_per_epoch),
+            false => s,
+        });
     trainer.set_schedule(schedule);
     trainer.set_keep_epochs(args.keep_epochs);
     trainer.set_checkpoint_every(checkpoint_every);
@@ -391,8 +401,15 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
         args.batch,
         args.lr,
         trainer.state().schedule.map_or(String::new(), |s| format!(
-            " (cosine to {} at epoch {}, from epoch {})",
-            s.end_lr, s.to_epoch, s.from_epoch
+            " (cosine to {} at epoch {}, from epoch {}{})",
+            s.end_lr,
+            s.to_epoch,
+            s.from_epoch,
+            if s.steps_per_epoch.is_some() {
+                ", step by step"
+            } else {
+                ""
+            }
         )),
         trainer
             .state()
@@ -402,7 +419,6 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
             )),
         out.display()
     );
-    let batches_per_epoch = train.indices.len().div_ceil(args.batch.max(1)) as u64;
     let bar = ProgressBar::new(batches_per_epoch);
     bar.set_style(
         ProgressStyle::with_template(

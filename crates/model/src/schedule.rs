@@ -6,7 +6,9 @@ use crate::error::{ModelError, Result};
 
 /// Cosine annealing: the learning rate falls from `start_lr` at epoch `from_epoch` to
 /// `end_lr` at epoch `to_epoch` along half a cosine, and stays at `end_lr` after. Epochs are
-/// counted as completed epochs (the rate of the epoch that starts after `e` are done).
+/// counted as completed epochs (the rate of the epoch that starts after `e` are done). The
+/// rate changes once an epoch, or at every step when `steps_per_epoch` is set, so that a
+/// schedule of a few long epochs ends at `end_lr` instead of a rung above it.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CosineSchedule {
     /// Learning rate at `from_epoch`.
@@ -17,6 +19,10 @@ pub struct CosineSchedule {
     pub from_epoch: usize,
     /// Epoch the schedule ends at (> `from_epoch`).
     pub to_epoch: usize,
+    /// Steps in one epoch, when the rate follows the cosine step by step (`None`: epoch by
+    /// epoch; checkpoints written before this field existed read as `None`).
+    #[serde(default)]
+    pub steps_per_epoch: Option<u64>,
 }
 
 impl CosineSchedule {
@@ -38,13 +44,37 @@ impl CosineSchedule {
             end_lr,
             from_epoch,
             to_epoch,
+            steps_per_epoch: None,
         })
+    }
+
+    /// The same schedule followed step by step, an epoch being `steps` steps (at least 1).
+    pub fn per_step(self, steps: u64) -> Self {
+        CosineSchedule {
+            steps_per_epoch: Some(steps.max(1)),
+            ..self
+        }
     }
 
     /// The learning rate of the epoch that starts after `epoch` epochs are completed.
     pub fn lr(&self, epoch: usize) -> f64 {
+        self.lr_at(epoch as f64)
+    }
+
+    /// The learning rate of step `step` (0-based, counting every batch) of the epoch that
+    /// starts after `epoch` epochs: [`CosineSchedule::lr`] of that epoch unless the schedule
+    /// goes step by step, then the cosine at the fractional epoch `epoch + step / steps`.
+    pub fn lr_of_step(&self, epoch: usize, step: usize) -> f64 {
+        match self.steps_per_epoch {
+            Some(n) => self.lr_at(epoch as f64 + step as f64 / n as f64),
+            None => self.lr(epoch),
+        }
+    }
+
+    /// The cosine at `position` (completed epochs, fractional).
+    fn lr_at(&self, position: f64) -> f64 {
         let span = (self.to_epoch - self.from_epoch) as f64;
-        let t = (epoch.saturating_sub(self.from_epoch) as f64 / span).min(1.0);
+        let t = ((position - self.from_epoch as f64).max(0.0) / span).min(1.0);
         self.end_lr + (self.start_lr - self.end_lr) * 0.5 * (1.0 + (std::f64::consts::PI * t).cos())
     }
 
@@ -54,6 +84,7 @@ impl CosineSchedule {
         self.start_lr == other.start_lr
             && self.end_lr == other.end_lr
             && self.to_epoch == other.to_epoch
+            && self.steps_per_epoch == other.steps_per_epoch
     }
 }
 
@@ -71,6 +102,33 @@ mod tests {
         assert!((s.lr(50) - 1e-5).abs() < 1e-15);
         let rates: Vec<f64> = (10..=20).map(|e| s.lr(e)).collect();
         assert!(rates.windows(2).all(|w| w[1] < w[0]));
+    }
+
+    #[test]
+    fn per_step_follows_the_cosine_inside_each_epoch() {
+        let epochs = CosineSchedule::new(3e-4, 1e-5, 1, 4).unwrap();
+        let steps = epochs.per_step(1000);
+        // At each epoch's first step both give the epoch's rate.
+        for e in 0..6 {
+            assert_eq!(steps.lr_of_step(e, 0), epochs.lr(e));
+            assert_eq!(epochs.lr_of_step(e, 500), epochs.lr(e));
+        }
+        // Inside an epoch the per-step rate falls between the rungs ...
+        let mid = steps.lr_of_step(2, 500);
+        assert!(mid < epochs.lr(2) && mid > epochs.lr(3));
+        let direct = 1e-5 + (3e-4 - 1e-5) * 0.5 * (1.0 + (std::f64::consts::PI * 0.5).cos());
+        assert!((mid - direct).abs() < 1e-15);
+        // ... and the last epoch's last step is at the end rate, not a rung above it.
+        assert!(epochs.lr(3) > 5e-5);
+        assert!((steps.lr_of_step(3, 999) - 1e-5).abs() < 1e-9);
+        assert!(!steps.same_plan(&epochs));
+    }
+
+    #[test]
+    fn a_checkpoint_without_steps_per_epoch_reads_as_epoch_by_epoch() {
+        let old = r#"{"start_lr":0.001,"end_lr":1e-5,"from_epoch":0,"to_epoch":3}"#;
+        let s: CosineSchedule = serde_json::from_str(old).unwrap();
+        assert_eq!(s, CosineSchedule::new(1e-3, 1e-5, 0, 3).unwrap());
     }
 
     #[test]

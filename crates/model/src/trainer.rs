@@ -432,6 +432,9 @@ impl Trainer {
                 progress.add_empty();
                 continue;
             }
+            if let Some(s) = self.state.schedule {
+                self.lr = s.lr_of_step(self.state.epoch, progress.batches);
+            }
             let report = self.step(&samples)?;
             progress.add(&report, samples.len());
             progress.seconds = before + start.elapsed().as_secs_f64();

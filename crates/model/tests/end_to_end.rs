@@ -535,6 +535,42 @@ fn corrupt_or_foreign_checkpoints_are_clear_errors() {
 }
 
 #[test]
+fn a_per_step_schedule_changes_the_rate_inside_each_epoch() {
+    let device = Device::flex();
+    let dir = tempfile::tempdir().unwrap();
+    let s = setup(Variant::Naive, 60);
+    let data = samples(&s, 3);
+    let train = || {
+        data.chunks(1)
+            .map(|c| Ok::<_, String>(c.to_vec()))
+            .collect::<Vec<_>>()
+    };
+    let mut trainer = Trainer::new(s.clone(), LossConfig::new(), 1e-3, &device).unwrap();
+    let schedule = CosineSchedule::new(1e-3, 1e-5, 0, 2).unwrap().per_step(3);
+    trainer.set_schedule(Some(schedule));
+    let reports = trainer
+        .fit(
+            2,
+            |_, _| train(),
+            None::<fn() -> Vec<_>>,
+            dir.path(),
+            |_| {},
+        )
+        .unwrap();
+    // Each report carries its epoch's last rate: step 2 of 3, not the epoch's first.
+    assert!((reports[0].lr - schedule.lr_of_step(0, 2)).abs() < 1e-15);
+    assert!(reports[0].lr < schedule.lr(0) && reports[0].lr > schedule.lr(1));
+    assert!((reports[1].lr - schedule.lr_of_step(1, 2)).abs() < 1e-15);
+    assert!(reports[1].lr < schedule.lr(1));
+    // The checkpoint keeps the plan, so resuming with it continues step by step.
+    let (last, _, _) = Trainer::output_paths(dir.path());
+    assert_eq!(
+        load_checkpoint(&last).unwrap().state.schedule,
+        Some(schedule)
+    );
+}
+
+#[test]
 fn trainer_writes_checkpoints_and_metrics_and_resumes() {
     let device = Device::flex();
     let dir = tempfile::tempdir().unwrap();
