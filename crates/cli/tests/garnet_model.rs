@@ -137,6 +137,34 @@ fn train_resume_eval_and_drape() {
         .unwrap()
         .ends_with(",train_grad_norm,vertex_power"));
 
+    // The same cosine step by step: a single epoch already ends below its start rate.
+    let per_step = tmp.path().join("per-step");
+    let per_step_args = ["--batch", "1", "--cosine-to", "1e-4", "--cosine-per-step"];
+    let log = ok(&train_args(data, "naive", "1", &per_step, &per_step_args));
+    assert!(
+        log.contains("cosine to 0.0001 at epoch 1, from epoch 0, step by step"),
+        "{log}"
+    );
+    let csv = std::fs::read_to_string(per_step.join("metrics.csv")).unwrap();
+    let lr: f64 = csv
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .nth(2)
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(lr > 1e-4 && lr < 1e-3, "{csv}");
+    let err = fails(&train_args(
+        data,
+        "naive",
+        "1",
+        &per_step,
+        &["--cosine-per-step"],
+    ));
+    assert!(err.contains("--cosine-to"), "{err}");
+
     // Table 1 / Table 2 / precision curves.
     let eval = tmp.path().join("eval");
     let best = local.join("best.garnet");
