@@ -5,9 +5,9 @@
 # both extensions (configs/contact-rest.json), batch 1, gradients clipped to 200, one thread,
 # one epoch at 3e-4, then 3e-4 along a cosine to 1e-5 at epoch EPOCHS, step by step (a
 # schedule of a few epochs over a large set would otherwise end a rung above 1e-5; the
-# T-shirt's 30 short epochs went epoch by epoch). Resumable: run it
-# again and it goes on from DIR's mid-epoch or last checkpoint. Arguments after DIR go to
-# both `garnet train` calls as they are. Run from the repository root:
+# T-shirt's 30 short epochs went epoch by epoch). Resumable: run it again and it goes on
+# from DIR's mid-epoch or last checkpoint. Arguments after DIR go to both `garnet train`
+# calls as they are. Run from the repository root:
 #   nohup scripts/scratch_run.sh GARMENT VARIANT DATA EPOCHS DIR [TRAIN_ARG...] >> DIR.log 2>&1 &
 # The sweater's and jeans' Global and Naive networks of session 54:
 #   scripts/scratch_run.sh sweater global out/standard-x9-sw54-lbs 4 out/runs/sweater-global

@@ -432,6 +432,7 @@ impl Trainer {
                 progress.add_empty();
                 continue;
             }
+            // The schedule's rate for this step (the epoch's rate unless it goes step by step).
             if let Some(s) = self.state.schedule {
                 self.lr = s.lr_of_step(self.state.epoch, progress.batches);
             }
@@ -529,9 +530,6 @@ impl Trainer {
             path: out_dir.to_path_buf(),
             source: e,
         })?;
-        if let Some(s) = self.state.schedule {
-            self.lr = s.lr(self.state.epoch);
-        }
         self.state.averaged_epochs.clear();
         self.state.averaged_weights.clear();
         let earlier_sittings = self.state.partial.as_ref().map_or(0.0, |p| p.seconds);
