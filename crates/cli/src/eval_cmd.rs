@@ -511,26 +511,7 @@ fn write_reports(
             by_motion: motions,
         },
     )?;
-    // Sixteen distinct colours: the nine shipped models and three DQS rows are twelve curves,
-    // and ten colours drew two of them alike.
-    let colors = [
-        [31, 119, 180],
-        [255, 127, 14],
-        [44, 160, 44],
-        [214, 39, 40],
-        [148, 103, 189],
-        [140, 86, 75],
-        [227, 119, 194],
-        [127, 127, 127],
-        [188, 189, 34],
-        [23, 190, 207],
-        [0, 0, 0],
-        [174, 199, 232],
-        [152, 223, 138],
-        [255, 187, 120],
-        [120, 60, 160],
-        [0, 100, 60],
-    ];
+    let colors = render::palette::CURVES;
     let series = |curve: fn(&Row) -> &Vec<f32>, xs: Vec<f32>| -> Vec<Series> {
         rows.iter()
             .enumerate()

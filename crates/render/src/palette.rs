@@ -32,6 +32,28 @@ pub const MISSING: [u8; 3] = [128, 128, 128];
 /// Distinct garment colours, in order, for scenes with several garments.
 pub const GARMENTS: [[u8; 3]; 5] = [TSHIRT_BLUE, SWEATER_RED, JEANS_INDIGO, OLIVE, MUSTARD];
 
+/// Distinct line colours, in order, for the curves of one chart. Sixteen: `garnet eval` of
+/// the nine shipped models draws twelve curves (DQS once a garment), and with ten colours
+/// two pairs of them were drawn alike.
+pub const CURVES: [[u8; 3]; 16] = [
+    [31, 119, 180],
+    [255, 127, 14],
+    [44, 160, 44],
+    [214, 39, 40],
+    [148, 103, 189],
+    [140, 86, 75],
+    [227, 119, 194],
+    [127, 127, 127],
+    [188, 189, 34],
+    [23, 190, 207],
+    [0, 0, 0],
+    [174, 199, 232],
+    [152, 223, 138],
+    [255, 187, 120],
+    [120, 60, 160],
+    [0, 100, 60],
+];
+
 /// Control points of the heat ramp, low to high: deep blue, blue, cyan, green, yellow,
 /// orange, red, dark red (evenly spaced over [0, 1]).
 const HEAT: [[u8; 3]; 8] = [
@@ -111,5 +133,17 @@ mod tests {
         assert_eq!(mix(SKIN, INK, 0.0), SKIN);
         let legend = heat_legend(200, "0 cm", "2 cm");
         assert_eq!(legend.width, 200);
+    }
+
+    /// Regression (session 55): twelve curves of one chart must not share a colour. Any two
+    /// curve colours differ by at least 40 (of 255) in some channel.
+    #[test]
+    fn curve_colours_are_distinct() {
+        for (i, a) in CURVES.iter().enumerate() {
+            for b in &CURVES[i + 1..] {
+                let gap = (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap();
+                assert!(gap >= 40, "{a:?} and {b:?} are too alike");
+            }
+        }
     }
 }
