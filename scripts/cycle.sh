@@ -1,5 +1,5 @@
 #!/bin/bash
-# One run of a training cycle as the T-shirt's last (docs/model.md "The T-shirt's cycle on
+# One run of a training cycle as the T-shirt's last (docs/training-log.md "The T-shirt's cycle on
 # t99, two seeds" and "The T-shirt under 1.5 cm"): GarNet-Local for GARMENT on DATA's
 # training drapes, every drape, from the network START (copied to DIR/last.garnet when DIR
 # holds no checkpoint yet; a model file has no optimiser state, so Adam starts afresh),

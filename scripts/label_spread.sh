@@ -1,6 +1,6 @@
 #!/bin/bash
 # How far apart equally valid labels are, and how much of a network's error that is
-# (docs/model.md "How far apart equally valid labels are (session 52)"). Makes DATASET's
+# (docs/training-log.md "How far apart equally valid labels are (session 52)"). Makes DATASET's
 # test split again twice, with the cloth 0.1% heavier (set a) and 0.1% lighter (set b), a
 # physically empty change; evaluates each MODEL on the three sets with --save-drapes; and
 # prints `scripts/drape_errors.py noise` for each. Resumable: what is made is kept in OUT.

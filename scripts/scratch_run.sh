@@ -1,6 +1,6 @@
 #!/bin/bash
 # One network trained from scratch with the recipe of the shipped T-shirt Global and Naive
-# (docs/model.md "Shipped with the extensions", session 20), on every training drape of DATA
+# (docs/training-log.md "Shipped with the extensions", session 20), on every training drape of DATA
 # (session 21: the filter to clean drapes cost more than it saved; pass --at-rest
 # --max-strain 5 for the T-shirt's own filter): VARIANT for GARMENT with
 # both extensions (configs/contact-rest.json), batch 1, gradients clipped to 200, one thread,

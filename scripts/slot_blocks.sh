@@ -7,7 +7,7 @@
 # ./target/release/garnet; usage, from the repository root:
 #   nohup scripts/slot_blocks.sh SPEC OUT BASE STRIDE SPLIT JOBS BLOCK... > LOG 2>&1 &
 # The T-shirts of standard-x9-t99-lbs's training bodies (t81's slots 0-80 are blocks 0-8,
-# the fresh slots 81-98 blocks 9-10; docs/model.md "Remaking t81 into t99"):
+# the fresh slots 81-98 blocks 9-10; docs/training-log.md "Remaking t81 into t99"):
 #   scripts/slot_blocks.sh specs/standard-x9-t99-lbs.toml out/standard-x9-t99-lbs 0 11 \
 #     train 2 0 1 2 3 4 5 6 7 8
 # and its 900 validation T-shirts (slots 0-44 of the validation bodies):
