@@ -23,6 +23,13 @@ DIR/MODEL/samples.csv), read against the dataset's manifest. Needs numpy (and sc
                                            (E_dist and E_norm), and the split into label spread
                                            and network error, by motion too (DATASET's
                                            manifest names them)
+  drape_errors.py shared A B A2 B2         how much of their error two models share, and
+                                           what averaging them can gain: A and B are their
+                                           drapes of one label set, A2 and B2 of the same
+                                           samples simulated again (as for `noise`); blends
+                                           w A + (1 - w) B, the correlation of the two
+                                           models' own errors (the labels' spread taken
+                                           out) and the floor of an ensemble of such models
 """
 import csv
 import glob
@@ -317,6 +324,44 @@ def noise(drapes, others, scales=(0.5, 0.75, 0.9, 1.0)):
               f"{cell('pair'):6.3f}")
 
 
+def shared(a, b, a2, b2, weights=(1.0, 0.9, 0.8, 0.7, 0.6, 0.5)):
+    """Two models' errors against one label set (a, b) and a second, independent one (a2,
+    b2: the same models, the same samples simulated again). The labels' spreads are
+    independent, so the mean dot product of model A's error against one set with model B's
+    against the other holds their own errors only (A with itself: its own error squared).
+    Averaging K models whose own errors correlate r pairwise leaves sqrt(r + (1 - r) / K)
+    of one's own error, never less than sqrt(r)."""
+    blends = {w: [] for w in weights}
+    per_drape = []
+    dot = {'aa': 0.0, 'bb': 0.0, 'ab': 0.0, 'labels': 0.0}
+    count = 0
+    for row in a.rows:
+        index = int(row['index'])
+        net_a, net_b = a.mesh(index, 'net'), b.mesh(index, 'net')
+        label, label2 = a.mesh(index, 'sim'), a2.mesh(index, 'sim')
+        for w in weights:
+            blends[w].append(mean_dist_cm(w * net_a + (1 - w) * net_b, label))
+        per_drape.append((mean_dist_cm(net_a, label), mean_dist_cm(net_b, label)))
+        ea, eb = net_a - label, net_b - label
+        ea2, eb2 = a2.mesh(index, 'net') - label2, b2.mesh(index, 'net') - label2
+        dot['aa'] += (ea * ea2).sum()
+        dot['bb'] += (eb * eb2).sum()
+        dot['ab'] += ((ea * eb2).sum() + (ea2 * eb).sum()) / 2
+        dot['labels'] += ((label - label2) ** 2).sum() / 2
+        count += len(net_a)
+    own = {key: value / count * 1e4 for key, value in dot.items()}
+    r = own['ab'] / np.sqrt(own['aa'] * own['bb'])
+    print(f'{len(per_drape)} drapes; E_dist of w A + (1 - w) B against the first labels:')
+    for w in weights:
+        print(f'  w {w:.1f}: {np.mean(blends[w]):.3f} cm')
+    print(f'per-drape E_dist of A and B correlate {np.corrcoef(np.array(per_drape).T)[0, 1]:.3f}')
+    print(f"own error (per-vertex RMS): A {np.sqrt(own['aa']):.3f} cm, B {np.sqrt(own['bb']):.3f} "
+          f"cm; the labels' spread {np.sqrt(own['labels']):.3f} cm")
+    print(f'the two own errors correlate {r:.3f}: an ensemble of models that differ as much '
+          f"keeps at least {np.sqrt(max(r, 0)):.3f} of A's own error, "
+          f"{np.sqrt(max(r, 0) * own['aa']):.3f} cm")
+
+
 if __name__ == '__main__':
     commands = {'by-stat': by_stat, 'shrink': shrink, 'scales': scales, 'contact': contact,
                 'smooth': smooth}
@@ -324,6 +369,8 @@ if __name__ == '__main__':
         regions(Drapes(sys.argv[2]), sys.argv[3])
     elif len(sys.argv) >= 5 and sys.argv[1] == 'noise':
         noise(Drapes(sys.argv[3], sys.argv[2]), [Drapes(d) for d in sys.argv[4:]])
+    elif len(sys.argv) == 6 and sys.argv[1] == 'shared':
+        shared(*(Drapes(d) for d in sys.argv[2:]))
     elif len(sys.argv) >= 3 and sys.argv[1] in commands:
         commands[sys.argv[1]](Drapes(sys.argv[2], sys.argv[3] if len(sys.argv) > 3 else None))
     else:
