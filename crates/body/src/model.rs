@@ -16,10 +16,10 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
-use geom::io::le::from_le;
+use geom::io::le::{from_le, typed_tensor};
 use geom::TriMesh;
 use glam::{EulerRot, Quat, Vec3};
-use safetensors::{tensor::TensorView, Dtype, SafeTensors};
+use safetensors::{Dtype, SafeTensors};
 use serde::{Deserialize, Serialize};
 
 use crate::phenotype::Phenotype;
@@ -100,18 +100,7 @@ impl BodyModel {
             )));
         }
         let st = SafeTensors::deserialize(&bytes).map_err(|e| bad(e.to_string()))?;
-        let get = |name: &str, dtype: Dtype| -> Result<TensorView<'_>, BodyError> {
-            let t = st
-                .tensor(name)
-                .map_err(|_| bad(format!("missing tensor {name}")))?;
-            if t.dtype() != dtype {
-                return Err(bad(format!(
-                    "tensor {name} has dtype {:?}, expected {dtype:?}",
-                    t.dtype()
-                )));
-            }
-            Ok(t)
-        };
+        let get = |name: &str, dtype: Dtype| typed_tensor(&st, name, dtype).map_err(bad);
         let template: Vec<Vec3> = from_le::<f32>(get("vertices", Dtype::F32)?.data())
             .chunks_exact(3)
             .map(|c| Vec3::new(c[0], c[1], c[2]))

@@ -13,7 +13,7 @@ use std::path::Path;
 
 use body::rig::Bone;
 use body::{Phenotype, Rig, ShapedBody, SkinWeights};
-use geom::io::le::{from_le, to_le};
+use geom::io::le::{from_le, to_le, typed_tensor};
 use geom::TriMesh;
 use glam::{Quat, Vec3};
 use safetensors::{tensor::TensorView, Dtype, SafeTensors};
@@ -247,16 +247,7 @@ impl GarmentTemplate {
         }
         let st = SafeTensors::deserialize(bytes).map_err(|e| bad(e.to_string()))?;
         let data = |name: &str, dtype: Dtype| -> Result<&[u8], GarmentError> {
-            let t = st
-                .tensor(name)
-                .map_err(|_| bad(format!("missing tensor {name}")))?;
-            if t.dtype() != dtype {
-                return Err(bad(format!(
-                    "tensor {name} is {:?}, expected {dtype:?}",
-                    t.dtype()
-                )));
-            }
-            Ok(t.data())
+            Ok(typed_tensor(&st, name, dtype).map_err(bad)?.data())
         };
         let vec3s = |name: &str| -> Result<Vec<Vec3>, GarmentError> {
             Ok(from_le::<f32>(data(name, Dtype::F32)?)

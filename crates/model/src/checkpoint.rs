@@ -26,6 +26,7 @@ use burn::optim::ModuleOptimizer;
 use burn::prelude::*;
 use burn::store::ModuleRecord;
 use burn::tensor::Bytes;
+use geom::io::le::typed_tensor;
 use glam::Vec3;
 use safetensors::{tensor::TensorView, Dtype, SafeTensors};
 use serde::{Deserialize, Serialize};
@@ -425,16 +426,7 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint> {
     let st = SafeTensors::deserialize(&bytes).map_err(|e| bad(e.to_string()))?;
     let names = st.names();
     let data = |name: &str, dtype: Dtype| -> Result<&[u8]> {
-        let t = st
-            .tensor(name)
-            .map_err(|_| bad(format!("missing tensor {name}")))?;
-        if t.dtype() != dtype {
-            return Err(bad(format!(
-                "tensor {name} is {:?}, expected {dtype:?}",
-                t.dtype()
-            )));
-        }
-        Ok(t.data())
+        Ok(typed_tensor(&st, name, dtype).map_err(bad)?.data())
     };
     let f32s: Vec<f32> = data("template.vertices", Dtype::F32)?
         .chunks_exact(4)
