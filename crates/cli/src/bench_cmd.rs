@@ -45,10 +45,10 @@ pub enum BenchCmd {
         /// Where the networks run.
         #[arg(long, value_enum, default_value_t = DeviceArg::Cpu)]
         device: DeviceArg,
-        /// Time networks of these widths and inputs (a JSON file of `GarNetConfig` fields
-        /// over the defaults, as `garnet train --config`) instead of the defaults; the
-        /// same-drape rows then compare GarNet-Local of this file with the paper's.
-        #[arg(long, value_name = "FILE")]
+        /// Time networks of a training recipe's widths and inputs (its `[network]`, each
+        /// variant in turn) instead of the defaults; the same-drape rows then compare
+        /// GarNet-Local of this recipe with the paper's.
+        #[arg(long = "recipe", value_name = "FILE.toml")]
         config: Option<std::path::PathBuf>,
     },
 }

@@ -9,9 +9,8 @@ use model::bench::{bench_forward, bench_train_step, Timing};
 use model::{Draper, GarNetConfig, ModelSetup, Variant};
 
 use crate::bench_cmd::TshirtCase;
-use crate::drape_cmd::{beside_push_out_collider, push_out_gap, PUSH_OUT_WITHIN};
 use crate::model_device::DeviceArg;
-use crate::train_cmd::network_config;
+use garnet::drape::{beside_push_out_collider, push_out_gap, PUSH_OUT_WITHIN};
 use std::path::Path;
 
 /// Body vertices the networks see (the body model's mesh).
@@ -20,8 +19,8 @@ const BODY_VERTICES: usize = 13380;
 /// Runs the benchmark and prints a Markdown table; the reference is the DQS warp of a T-shirt
 /// with `edge` metres; with `simulator`, also the GarNet-Local and simulator times of the same
 /// drape of that T-shirt. The networks run on `device` (the DQS warp and the simulator always
-/// on the CPU) with the widths and inputs of the `config` file (`garnet train --config`), or
-/// the defaults.
+/// on the CPU) with the widths and inputs of the `config` recipe (its `[network]`), or the
+/// defaults.
 pub fn bench_model(
     runs: usize,
     sizes: &[usize],
@@ -107,8 +106,8 @@ pub fn bench_model(
     Ok(())
 }
 
-/// The networks a run of the benchmark times: the defaults, or a `--config` file's (read
-/// once).
+/// The networks a run of the benchmark times: the defaults, or a recipe's widths and inputs
+/// (read once).
 struct BenchNetworks {
     /// Each variant's config, in the order of [`Variant::ALL`].
     configs: Vec<GarNetConfig>,
@@ -116,22 +115,17 @@ struct BenchNetworks {
 }
 
 impl BenchNetworks {
-    /// The networks of the `file`'s widths and inputs, or the defaults.
+    /// The networks of the recipe `file`'s widths and inputs (each variant in turn), or the
+    /// defaults.
     fn new(file: Option<&Path>) -> anyhow::Result<Self> {
+        let recipe = file.map(model::Recipe::load).transpose()?;
         let configs = Variant::ALL
             .iter()
-            .map(|&v| match file {
-                // Extra mesh-convolution blocks mean nothing to Naive: it is timed without.
-                Some(path) if v == Variant::Naive => {
-                    network_config(path, Variant::Global).map(|mut c| {
-                        c.variant = v;
-                        c.with_extra_blocks(0)
-                    })
-                }
-                Some(path) => network_config(path, v),
+            .map(|&v| match &recipe {
+                Some(r) => r.network_config().map(|c| GarNetConfig { variant: v, ..c }),
                 None => Ok(GarNetConfig::new(v)),
             })
-            .collect::<anyhow::Result<_>>()?;
+            .collect::<model::Result<_>>()?;
         Ok(Self {
             configs,
             from_file: file.is_some(),

@@ -1,7 +1,7 @@
-//! `garnet`: fast, accurate 3D cloth draping. Thin commands over the pipeline crates.
+//! `garnet`: fast, accurate 3D cloth draping. Thin commands over the `garnet` library and
+//! the pipeline crates.
 
 mod assets_cmd;
-mod average_cmd;
 mod bench_cmd;
 mod bench_model;
 mod body_cmd;
@@ -11,12 +11,9 @@ mod dataset_show;
 mod drape_cmd;
 mod drape_filter_args;
 mod eval_cmd;
-mod eval_motion;
-mod eval_save;
 mod export_cmd;
 mod garment_cmd;
 mod garment_sheet;
-mod grow_cmd;
 mod log_lines;
 mod model_device;
 mod output;
@@ -26,7 +23,6 @@ mod shape_args;
 mod simulate_cmd;
 mod simulate_sheet;
 mod train_cmd;
-mod train_drapes;
 
 use clap::{Parser, Subcommand};
 
@@ -64,14 +60,10 @@ enum Cmd {
     Drape(drape_cmd::DrapeArgs),
     /// Evaluate trained models on a dataset split: the paper's Table 1, Table 2, Figure 4.
     Eval(eval_cmd::EvalArgs),
-    /// Train a GarNet network for one garment of a dataset.
+    /// Train a GarNet network for one garment of a dataset, by a recipe.
     Train(train_cmd::TrainArgs),
     /// Export a training checkpoint as a model to ship, with its model card.
     Export(export_cmd::ExportArgs),
-    /// Average the networks of several checkpoints of one run into one (weight averaging).
-    Average(average_cmd::AverageArgs),
-    /// Grow a trained network (wider layers, more residual blocks) draping as before (train it on after).
-    Grow(grow_cmd::GrowArgs),
     /// The paper's errors (E_dist, E_norm) between two drapes of one garment mesh.
     Compare(compare_cmd::CompareArgs),
     /// Benchmarks measured in one run, reported with ratios to a reference.
@@ -92,8 +84,6 @@ fn main() {
         Some(Cmd::Drape(a)) => drape_cmd::run(a),
         Some(Cmd::Eval(a)) => eval_cmd::run(a),
         Some(Cmd::Export(a)) => export_cmd::run(a),
-        Some(Cmd::Average(a)) => average_cmd::run(a),
-        Some(Cmd::Grow(a)) => grow_cmd::run(a),
         Some(Cmd::Compare(a)) => compare_cmd::run(a),
         Some(Cmd::Train(a)) => train_cmd::run(a),
         Some(Cmd::Bench(c)) => bench_cmd::run(c),

@@ -85,11 +85,3 @@ pub fn create_parent(path: &Path) -> anyhow::Result<()> {
     }
     Ok(())
 }
-
-/// This process's command line as `garnet ARGS...` (for the command a checkpoint records).
-pub fn command_line() -> String {
-    std::iter::once("garnet".to_string())
-        .chain(std::env::args().skip(1))
-        .collect::<Vec<_>>()
-        .join(" ")
-}

@@ -1,158 +1,88 @@
-//! `garnet train`: trains a GarNet variant for one garment of a dataset, with validation
-//! each epoch, best and last checkpoints, `--resume`, a progress bar with the loss terms
-//! and a metrics log (`metrics.csv`).
+//! `garnet train --recipe recipes/GARMENT-VARIANT.toml`: trains a GarNet network for one
+//! garment of a dataset by a recipe (network, loss, schedule, training drapes; see
+//! [`model::recipe`]), with validation each epoch, best and last checkpoints, `--resume`, a
+//! progress bar with the loss terms and a metrics log (`metrics.csv`). The checkpoints store
+//! the recipe, so `garnet export` puts the command on the model card.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{bail, Context};
 use burn::module::Module;
-use clap::{Args, ValueEnum};
+use clap::Args;
 use dataset::batches::{BatchOptions, Batches, Order};
 use dataset::Dataset;
+use garnet::drapes::{check_body_skinning, keep_drapes};
+use garnet::export::recipe_filter;
 use indicatif::{ProgressBar, ProgressStyle};
-use model::{
-    BodyTopology, CosineSchedule, GarNetConfig, LossConfig, ModelSetup, Sample, Trainer, Variant,
-    PAPER_LEARNING_RATE,
-};
+use model::{BodyTopology, ModelSetup, Recipe, RecipeRecord, Sample, Trainer};
 
-use crate::drape_filter_args::{filter_flags, keep_drapes, DrapeFilterArgs};
 use crate::log_lines::{LogLines, LOG_EVERY};
 use crate::model_device::DeviceArg;
 
 /// Arguments of `garnet train`.
 #[derive(Args, Debug, Clone)]
 pub struct TrainArgs {
-    /// Dataset folder (made by `garnet dataset generate`).
+    /// The training recipe (TOML: garment, variant, dataset, network, loss, schedule,
+    /// training drapes); one per shipped model in `recipes/`.
+    #[arg(long, value_name = "FILE.toml")]
+    pub recipe: PathBuf,
+    /// Dataset folder, instead of the recipe's `data`.
     #[arg(long, value_name = "DIR")]
-    pub data: PathBuf,
-    /// Garment name in the dataset (tshirt, sweater, jeans unless the spec named them).
-    #[arg(long)]
-    pub garment: String,
-    /// Network variant.
-    #[arg(long, value_enum, default_value_t = VariantArg::Local)]
-    pub variant: VariantArg,
-    /// Epochs to complete (counting those of a resumed run).
-    #[arg(long, default_value_t = 30)]
-    pub epochs: usize,
-    /// Samples per batch.
-    #[arg(long, default_value_t = 8)]
-    pub batch: usize,
-    /// Adam learning rate (the paper: 1e-3).
-    #[arg(long, default_value_t = PAPER_LEARNING_RATE)]
-    pub lr: f64,
-    /// Clip the gradients of each step to this joint L2 norm (as PyTorch's
-    /// `clip_grad_norm_`); kept by a resumed run unless given again. The metrics log's
-    /// `train_grad_norm` column shows the norms before clipping.
-    #[arg(long, value_name = "NORM")]
-    pub grad_clip: Option<f32>,
-    /// Mirror every other training sample left-right through the garment's plane of
-    /// symmetry (a reflected drape is another valid drape: twice the drapes seen per
-    /// epoch); kept by a resumed run.
-    #[arg(long)]
-    pub mirror: bool,
-    /// Anneal the learning rate along half a cosine from --lr (at the epoch this run starts
-    /// from) to this rate at --epochs; resuming with the same command continues the schedule.
-    #[arg(long, value_name = "LR")]
-    pub cosine_to: Option<f64>,
-    /// With --cosine-to: change the rate at every step instead of once an epoch, so that a
-    /// schedule of a few long epochs ends at --cosine-to (the metrics log then shows each
-    /// epoch's last rate). Part of the schedule's plan: resume with it given again.
-    #[arg(long, requires = "cosine_to")]
-    pub cosine_per_step: bool,
+    pub data: Option<PathBuf>,
     /// Output folder (checkpoints `best.garnet`, `last.garnet`, `metrics.csv`); default
     /// `runs/GARMENT-VARIANT`.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// Continue from `OUT/last.garnet` (network, optimiser and progress), or from inside
-    /// an epoch where `OUT/mid-epoch.garnet` is further on (see --checkpoint-minutes).
+    /// Continue from `OUT/last.garnet` (network, optimiser and progress), or from inside an
+    /// epoch where `OUT/mid-epoch.garnet` is further on; the run must have the same recipe
+    /// (the epoch count aside).
     #[arg(long)]
     pub resume: bool,
-    /// Inside an epoch, write `OUT/mid-epoch.garnet` every this many minutes (0: never),
-    /// so that a run stopped inside a long epoch resumes there with --resume, on the same
-    /// training set, batch size and seed. Removed when the epoch ends.
-    #[arg(long, value_name = "MINUTES", default_value_t = 10.0)]
-    pub checkpoint_minutes: f64,
-    /// Also keep every epoch's checkpoint as `OUT/epoch-N.garnet` (with the optimiser
-    /// state, about 9 MB for GarNet-Local): snapshots for `garnet average`, or to branch a
-    /// run from (copy one to another folder's `last.garnet` and `--resume` there).
-    #[arg(long)]
-    pub keep_epochs: bool,
-    /// Train on at most this many training samples (quick runs).
+    /// Epochs to complete, instead of the recipe's (a cosine schedule then ends there).
+    #[arg(long, value_name = "N")]
+    pub epochs: Option<usize>,
+    /// Train on at most this many training samples (quick runs), instead of the recipe's.
     #[arg(long, value_name = "N")]
     pub max_samples: Option<usize>,
-    /// Which training drapes to use (validation keeps every sample).
-    #[command(flatten)]
-    pub drapes: DrapeFilterArgs,
-    /// Loss weights: turn a term off for ablations (L_vertex stays).
-    #[arg(long)]
-    pub no_pen: bool,
-    /// See --no-pen.
-    #[arg(long)]
-    pub no_norm: bool,
-    /// See --no-pen.
-    #[arg(long)]
-    pub no_bend: bool,
-    /// L_vertex averages each vertex's distance to this power, in [1, 2]: 2 is the paper's
-    /// squared distance, 1 the distance itself (what E_dist reports; far-off vertices of
-    /// poorly settled drapes pull no harder than the rest). Given with --resume, it changes
-    /// the resumed run's loss from then on (a fine-tune); otherwise a resumed run keeps its
-    /// loss.
-    #[arg(long, value_name = "P")]
-    pub vertex_power: Option<f64>,
-    /// Weight of L_vertex (the paper: 1; the other weights stay the paper's). With
-    /// --vertex-power 1 in cm, a weight of 2 pulls a vertex 1 cm off as hard as the squared
-    /// loss does. With --resume, as --vertex-power.
-    #[arg(long, value_name = "W")]
-    pub vertex_weight: Option<f64>,
-    /// Length unit of the loss terms (the paper's weights balance them in centimetres).
-    #[arg(long, value_enum, default_value_t = LossUnit::Cm)]
-    pub loss_unit: LossUnit,
-    /// The body stream sees every N-th body vertex (farthest-point order; 4 gives 3345 of
-    /// the 13380, 2 the paper's ~6.9k). A new run only: a resumed run keeps its network.
+    /// Seed of the per-epoch shuffle, instead of the recipe's.
     #[arg(long, value_name = "N")]
-    pub body_subsample: Option<usize>,
-    /// The network's widths as a JSON file of `GarNetConfig` fields (any left out take their
-    /// defaults; `--variant` and `--body-subsample` override the file). A new run only: a
-    /// resumed run keeps its network.
-    #[arg(long, value_name = "FILE")]
-    pub config: Option<PathBuf>,
-    /// Seed of the per-epoch shuffle.
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
+    pub seed: Option<u64>,
     /// Where the network runs.
     #[arg(long, value_enum, default_value_t = DeviceArg::Cpu)]
     pub device: DeviceArg,
 }
 
-/// The three GarNet variants on the command line.
-#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
-pub enum VariantArg {
-    /// GarNet-Local (global and local body features, mesh convolutions).
-    Local,
-    /// GarNet-Global (global body features, mesh convolutions).
-    Global,
-    /// GarNet-Naive (two-stream PointNet, no mesh convolution).
-    Naive,
-}
-
-impl From<VariantArg> for Variant {
-    fn from(v: VariantArg) -> Self {
-        match v {
-            VariantArg::Local => Variant::Local,
-            VariantArg::Global => Variant::Global,
-            VariantArg::Naive => Variant::Naive,
+impl TrainArgs {
+    /// The recipe with this command line's overrides applied, and the command that names
+    /// them (for model cards).
+    pub fn recipe_record(&self) -> anyhow::Result<RecipeRecord> {
+        let mut recipe = Recipe::load(&self.recipe)?;
+        let mut command = format!("garnet train --recipe {}", self.recipe.display());
+        if let Some(d) = &self.data {
+            recipe.data = d.clone();
+            command += &format!(" --data {}", d.display());
         }
+        if let Some(e) = self.epochs {
+            recipe.schedule.epochs = e;
+            command += &format!(" --epochs {e}");
+        }
+        if let Some(n) = self.max_samples {
+            recipe.drapes.max_samples = Some(n);
+            command += &format!(" --max-samples {n}");
+        }
+        if let Some(s) = self.seed {
+            recipe.schedule.seed = s;
+            command += &format!(" --seed {s}");
+        }
+        recipe.validate().with_context(|| {
+            format!(
+                "{} with the command line's overrides",
+                self.recipe.display()
+            )
+        })?;
+        Ok(RecipeRecord { recipe, command })
     }
-}
-
-/// Length unit of the loss on the command line.
-#[derive(ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
-pub enum LossUnit {
-    /// Centimetres (L_vertex in cm^2).
-    Cm,
-    /// Metres.
-    M,
 }
 
 /// A dataset's samples of one garment and split, as the network's training samples.
@@ -225,70 +155,40 @@ impl<'a> GarmentSplit<'a> {
     }
 }
 
-/// Reads a `--config` file: a JSON object of [`GarNetConfig`] fields over the defaults of
-/// `variant`, whose variant it takes.
-pub fn network_config(path: &Path, variant: Variant) -> anyhow::Result<GarNetConfig> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("reading the network config {}", path.display()))?;
-    let mut fields: serde_json::Map<String, serde_json::Value> = serde_json::from_str(&text)
-        .with_context(|| format!("{}: not a JSON object of config fields", path.display()))?;
-    let defaults = serde_json::to_value(GarNetConfig::new(variant))?;
-    let serde_json::Value::Object(defaults) = defaults else {
-        bail!("GarNetConfig does not serialise to an object");
-    };
-    if let Some(unknown) = fields.keys().find(|k| !defaults.contains_key(*k)) {
-        bail!(
-            "{}: unknown network config field {unknown:?} (known: {})",
-            path.display(),
-            defaults.keys().cloned().collect::<Vec<_>>().join(", ")
-        );
-    }
-    let mut merged = defaults;
-    merged.append(&mut fields);
-    let mut config: GarNetConfig = serde_json::from_value(serde_json::Value::Object(merged))
-        .with_context(|| {
-            format!(
-                "{}: a network config field has the wrong type",
-                path.display()
-            )
-        })?;
-    config.variant = variant;
-    config
-        .validate()
-        .with_context(|| format!("network config {}", path.display()))?;
-    Ok(config)
-}
-
 /// Runs `garnet train`.
 pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
-    let data = Dataset::open(&args.data)?;
-    let mut train = GarmentSplit::new(&data, "train", &args.garment)?;
-    let filter = args.drapes.filter()?;
+    let record = args.recipe_record()?;
+    let recipe = &record.recipe;
+    let garment = recipe.garment.as_str();
+    let variant = recipe.variant()?;
+    let data = Dataset::open(&recipe.data)?;
+    let mut train = GarmentSplit::new(&data, "train", garment)?;
+    let filter = recipe_filter(recipe);
     if let Some(filter) = &filter {
-        let dropped = keep_drapes(&data, "train", &args.garment, &mut train.indices, filter)?;
+        let dropped = keep_drapes(&data, "train", garment, &mut train.indices, filter)?;
         eprintln!(
             "training on {} only: left out {dropped} training drapes",
             filter.describe()
         );
     }
-    if let Some(n) = args.max_samples {
-        train.indices.truncate(n.max(1));
+    if let Some(n) = recipe.drapes.max_samples {
+        train.indices.truncate(n);
     }
-    let valid = GarmentSplit::new(&data, "val", &args.garment).ok();
-    let variant: Variant = args.variant.into();
-    let out = args.out.clone().unwrap_or_else(|| {
-        PathBuf::from("runs").join(format!("{}-{}", args.garment, variant.name()))
-    });
+    let valid = GarmentSplit::new(&data, "val", garment).ok();
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("runs").join(format!("{garment}-{}", variant.name())));
     let device = args.device.device()?;
-    let checkpoint_every = checkpoint_interval(args.checkpoint_minutes)?;
+    let s = &recipe.schedule;
+    let checkpoint_every = checkpoint_interval(s.checkpoint_minutes)?;
     let from = match args.resume {
         true => Trainer::resume_point(&out)
             .with_context(|| format!("choosing the checkpoint to resume in {}", out.display()))?,
         false => None,
     };
-    let resumed = from.is_some();
     let mut trainer = if let Some(from) = &from {
-        let trainer = Trainer::resume(from, Some(args.lr), &device)
+        let trainer = Trainer::resume(from, Some(s.lr), &device)
             .with_context(|| format!("resuming {}", from.display()))?;
         match &trainer.state().partial {
             Some(p) => eprintln!(
@@ -299,6 +199,7 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
             ),
             None => eprintln!("resuming from {}", from.display()),
         }
+        check_same_recipe(trainer.recipe(), recipe, from)?;
         check_body_skinning(trainer.setup(), &data, from)?;
         trainer
     } else {
@@ -319,26 +220,22 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
             );
         }
         let template = train.template()?;
-        let garment_file = template.to_bytes(&args.data)?;
-        let mut config = match &args.config {
-            Some(path) => network_config(path, variant)?,
-            None => GarNetConfig::new(variant),
-        };
-        if let Some(n) = args.body_subsample {
-            config.body_subsample = n;
-        }
-        let setup = ModelSetup::new(config, template.mesh.clone(), &train.reference_body()?)?
-            .with_garment_file(garment_file)
-            .with_body_skinning(data.body_skinning().name())?
-            .with_body_faces(train.topology.faces.clone())?;
-        Trainer::new(setup, loss_config(args), args.lr, &device)?
+        let garment_file = template.to_bytes(&recipe.data)?;
+        let setup = ModelSetup::new(
+            recipe.network_config()?,
+            template.mesh.clone(),
+            &train.reference_body()?,
+        )?
+        .with_garment_file(garment_file)
+        .with_body_skinning(data.body_skinning().name())?
+        .with_body_faces(train.topology.faces.clone())?;
+        Trainer::new(setup, recipe.loss_config()?, s.lr, &device)?
     };
     // The count is part of the name: a dataset still being generated grows its validation
     // split, and a best figure measured on fewer drapes cannot be compared.
     let validation_set = format!(
-        "{}:{}:{}",
+        "{}:{garment}:{}",
         data.manifest().spec.name,
-        args.garment,
         valid.as_ref().map_or(0, |v| v.indices.len())
     );
     if let Some(old) = trainer.set_validation_set(&validation_set) {
@@ -347,76 +244,20 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
              validation set; this run validates on '{validation_set}' and starts its best afresh"
         );
     }
-    if args.grad_clip.is_some() {
-        trainer.set_max_grad_norm(args.grad_clip)?;
-    }
-    if resumed && (args.vertex_power.is_some() || args.vertex_weight.is_some()) {
-        let loss = with_vertex_args(trainer.loss_config().clone(), args);
-        eprintln!(
-            "L_vertex from here on: weight {}, distances to the power {} (the checkpoint's: \
-             weight {}, power {})",
-            loss.vertex,
-            loss.vertex_power,
-            trainer.loss_config().vertex,
-            trainer.loss_config().vertex_power
-        );
-        trainer.set_loss_config(loss)?;
-    }
-    if args.mirror {
-        trainer
-            .set_mirror(true)
-            .with_context(|| format!("--mirror with the '{}' template", args.garment))?;
-    }
-    if let Some(m) = trainer.mirror_map() {
-        eprintln!(
-            "mirroring every other training sample through x = {:.4} m (template reflections \
-             within {:.2} mm of its surface)",
-            m.plane_x(),
-            m.max_offset() * 1e3
-        );
-    }
-    let batches_per_epoch = train.indices.len().div_ceil(args.batch.max(1)) as u64;
-    let schedule = args
-        .cosine_to
-        .map(|end| CosineSchedule::new(args.lr, end, trainer.state().epoch, args.epochs))
-        .transpose()?
-        .map(|s| match args.cosine_per_step {
-            true => s.per_step(batches_per_epoch),
-            false => s,
-        });
-    trainer.set_schedule(schedule);
-    trainer.set_keep_epochs(args.keep_epochs);
+    trainer.set_max_grad_norm(s.grad_clip)?;
+    let batches_per_epoch = train.indices.len().div_ceil(s.batch) as u64;
+    trainer.set_schedule(recipe.lr_schedule(batches_per_epoch)?);
     trainer.set_checkpoint_every(checkpoint_every);
-    trainer.set_training_set(&training_set_name(&data, &train.indices, args));
-    trainer.set_command(crate::output::command_line());
-    trainer.set_train_drapes(filter_flags(filter.as_ref()));
+    trainer.set_training_set(&training_set_name(&data, &train.indices, recipe));
+    trainer.set_recipe(record.clone());
     let params = trainer.model().num_params();
     eprintln!(
-        "training {} ({params} parameters) on {} '{}' samples ({} validation), \
-         batch {}, lr {}{}{}, into {}",
+        "training {} ({params} parameters) on {} '{garment}' samples ({} validation) by {}, \
+         into {}",
         trainer.setup().config.method_name(),
         train.indices.len(),
-        args.garment,
         valid.as_ref().map_or(0, |v| v.indices.len()),
-        args.batch,
-        args.lr,
-        trainer.state().schedule.map_or(String::new(), |s| format!(
-            " (cosine to {} at epoch {}, from epoch {}{})",
-            s.end_lr,
-            s.to_epoch,
-            s.from_epoch,
-            if s.steps_per_epoch.is_some() {
-                ", step by step"
-            } else {
-                ""
-            }
-        )),
-        trainer
-            .state()
-            .max_grad_norm
-            .map_or(String::new(), |n| format!(
-                ", gradients clipped to norm {n}"
-            )),
+        record.command,
         out.display()
     );
     let bar = ProgressBar::new(batches_per_epoch);
@@ -426,7 +267,7 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
         )?
         .progress_chars("=> "),
     );
-    let seed = args.seed;
+    let (seed, batch) = (s.seed, s.batch);
     let train_batches = |epoch: usize, skip: usize| {
         bar.set_prefix((epoch + 1).to_string());
         bar.reset();
@@ -436,7 +277,7 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
         let mut log = LogLines::new(LOG_EVERY, "batches");
         train
             .batches(
-                args.batch,
+                batch,
                 Order::Shuffled {
                     seed,
                     epoch: epoch as u64,
@@ -455,8 +296,8 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
     };
     let valid_batches = valid
         .as_ref()
-        .map(|v| move || v.batches(args.batch, Order::InOrder, 0));
-    trainer.fit(args.epochs, train_batches, valid_batches, &out, |r| {
+        .map(|v| move || v.batches(batch, Order::InOrder, 0));
+    trainer.fit(s.epochs, train_batches, valid_batches, &out, |r| {
         let v = r.validation.map_or(String::new(), |v| {
             format!(
                 ", val E_dist {:.3} cm E_norm {:.2} deg",
@@ -488,10 +329,36 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// `--checkpoint-minutes` as the interval of mid-epoch checkpoints (`None` for 0: none).
+/// Fails, naming the checkpoint `from`, when the run it belongs to was trained by another
+/// recipe than `recipe` (the epoch count aside: a run may be extended), or by none.
+fn check_same_recipe(
+    stored: Option<&RecipeRecord>,
+    recipe: &Recipe,
+    from: &Path,
+) -> anyhow::Result<()> {
+    let Some(stored) = stored else {
+        bail!(
+            "{}: the checkpoint records no recipe; train into another --out",
+            from.display()
+        );
+    };
+    let mut same_epochs = stored.recipe.clone();
+    same_epochs.schedule.epochs = recipe.schedule.epochs;
+    if &same_epochs != recipe {
+        bail!(
+            "{}: the run was trained by another recipe ({}); resume it with that recipe or \
+             train into another --out",
+            from.display(),
+            stored.command
+        );
+    }
+    Ok(())
+}
+
+/// The recipe's `checkpoint_minutes` as the interval of mid-epoch checkpoints (`None` for 0: none).
 fn checkpoint_interval(minutes: f64) -> anyhow::Result<Option<Duration>> {
     if !(minutes.is_finite() && minutes >= 0.0) {
-        bail!("--checkpoint-minutes must be 0 (none) or more, got {minutes}");
+        bail!("checkpoint_minutes must be 0 (none) or more, got {minutes}");
     }
     Ok((minutes > 0.0).then(|| Duration::from_secs_f64(minutes * 60.0)))
 }
@@ -499,67 +366,16 @@ fn checkpoint_interval(minutes: f64) -> anyhow::Result<Option<Duration>> {
 /// The name of the training set and order a run's epochs take, which a mid-epoch checkpoint
 /// must be resumed with: the dataset, garment, sample count and a hash of the samples, the
 /// batch size, the shuffle's seed and the shards read together (the shuffle's window).
-fn training_set_name(data: &Dataset, indices: &[u64], args: &TrainArgs) -> String {
+fn training_set_name(data: &Dataset, indices: &[u64], recipe: &Recipe) -> String {
     let bytes: Vec<u8> = indices.iter().flat_map(|k| k.to_le_bytes()).collect();
     format!(
         "{}:{}:{} samples (sha256 {}), batch {}, seed {}, {} shards a window",
         data.manifest().spec.name,
-        args.garment,
+        recipe.garment,
         indices.len(),
         &dataset::hash::sha256_hex(&bytes)[..16],
-        args.batch.max(1),
-        args.seed,
+        recipe.schedule.batch,
+        recipe.schedule.seed,
         data.cache_shards()
     )
-}
-
-/// Fails, naming `model`, when the network `setup` learned from bodies posed another way than
-/// the dataset `data` poses them: its inputs would not be what it learned from.
-pub fn check_body_skinning(
-    setup: &ModelSetup,
-    data: &Dataset,
-    model: &std::path::Path,
-) -> anyhow::Result<()> {
-    let expected = data.body_skinning().name();
-    if setup.body_skinning != expected {
-        bail!(
-            "{}: the network learned from bodies posed with {}, the dataset in {} poses them \
-             with {expected}",
-            model.display(),
-            setup.body_skinning,
-            data.dir().display()
-        );
-    }
-    Ok(())
-}
-
-/// The paper's loss weights, with the terms `args` turned off set to zero and L_vertex's
-/// power and weight from `args`.
-fn loss_config(args: &TrainArgs) -> LossConfig {
-    let mut cfg = LossConfig::new();
-    cfg.units_per_metre = match args.loss_unit {
-        LossUnit::Cm => 100.0,
-        LossUnit::M => 1.0,
-    };
-    if args.no_pen {
-        cfg.pen = 0.0;
-    }
-    if args.no_norm {
-        cfg.norm = 0.0;
-    }
-    if args.no_bend {
-        cfg.bend = 0.0;
-    }
-    with_vertex_args(cfg, args)
-}
-
-/// `cfg` with L_vertex's power and weight from `args` where given.
-fn with_vertex_args(mut cfg: LossConfig, args: &TrainArgs) -> LossConfig {
-    if let Some(p) = args.vertex_power {
-        cfg.vertex_power = p;
-    }
-    if let Some(w) = args.vertex_weight {
-        cfg.vertex = w;
-    }
-    cfg
 }

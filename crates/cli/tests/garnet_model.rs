@@ -66,22 +66,21 @@ fn train_resume_eval_and_drape() {
     let data = dataset();
     let tmp = tempfile::tempdir().unwrap();
     let local = tmp.path().join("local");
-    let args = |epochs: &str| {
-        owned(&train_args(
-            data,
-            "local",
-            epochs,
-            &local,
-            &["--batch", "2"],
-        ))
-    };
-    let mut first = args("2");
-    first.push("--mirror".into());
-    let log = ok(&as_str(&first));
+    // The export below adds the metrics on the drapes the recipe's filter keeps.
+    let local_recipe = recipe(
+        tmp.path(),
+        "local",
+        data,
+        "local",
+        2,
+        "batch = 2",
+        "[drapes]\nmax_strain_pct = 1000.0\n",
+    );
+    let log = ok_v(train(&local_recipe, &local, &[]));
     assert!(
         log.contains("epoch 2")
             && log.contains("val E_dist")
-            && log.contains("mirroring every other training sample"),
+            && log.contains("by garnet train --recipe"),
         "{log}"
     );
     let metrics = local.join("metrics.csv");
@@ -90,80 +89,71 @@ fn train_resume_eval_and_drape() {
     for f in ["best.garnet", "last.garnet"] {
         assert!(local.join(f).is_file(), "{f}");
     }
-    // Resume to three epochs with L_vertex as the mean distance: one more row.
-    let mut resume = args("3");
-    resume.extend(["--resume", "--vertex-power", "1", "--vertex-weight", "2"].map(String::from));
-    let log = ok(&as_str(&resume));
-    // The resumed run keeps mirroring without being told again.
-    assert!(
-        log.contains("resuming") && log.contains("mirroring every other training sample"),
-        "{log}"
-    );
-    assert!(
-        log.contains("L_vertex from here on: weight 2, distances to the power 1 (the checkpoint's: weight 1, power 2)"),
-        "{log}"
-    );
+    // Resumed to three epochs by the same recipe: one more row; the checkpoint records the
+    // recipe as run and its command.
+    let log = ok_v(train(&local_recipe, &local, &["--resume", "--epochs", "3"]));
+    assert!(log.contains("resuming"), "{log}");
     assert_eq!(rows(&metrics), 4);
-    let powers: Vec<String> = std::fs::read_to_string(&metrics)
-        .unwrap()
-        .lines()
-        .skip(1)
-        .map(|l| l.rsplit(',').next().unwrap().to_string())
-        .collect();
-    assert_eq!(powers, ["2", "2", "1"]);
     let resumed = model::load_checkpoint(&local.join("last.garnet")).unwrap();
-    assert_eq!((resumed.loss.vertex, resumed.loss.vertex_power), (2.0, 1.0));
+    let record = resumed.recipe.expect("the recipe");
+    assert_eq!(
+        (record.recipe.schedule.epochs, record.recipe.schedule.batch),
+        (3, 2)
+    );
+    assert!(
+        record.command.ends_with("local.toml --epochs 3"),
+        "{}",
+        record.command
+    );
+    // Another recipe cannot resume the run.
+    let other = recipe(tmp.path(), "other", data, "local", 4, "batch = 1", "");
+    let err = fails_v(train(&other, &local, &["--resume"]));
+    assert!(err.contains("trained by another recipe"), "{err}");
 
     // Naive with clipped gradients and a cosine schedule over two epochs.
     let naive = tmp.path().join("naive");
-    let log = ok(&train_args(
+    let naive_recipe = recipe(
+        tmp.path(),
+        "naive",
         data,
         "naive",
-        "2",
-        &naive,
-        &["--grad-clip", "100", "--cosine-to", "1e-4"],
-    ));
-    assert!(
-        log.contains("cosine to 0.0001 at epoch 2, from epoch 0")
-            && log.contains("gradients clipped to norm 100")
-            && log.contains("lr 1.00e-3")
-            && log.contains("lr 5.50e-4"),
-        "{log}"
+        2,
+        "grad_clip = 100.0\ncosine_to = 1e-4",
+        "",
     );
+    ok_v(train(&naive_recipe, &naive, &[]));
     let csv = std::fs::read_to_string(naive.join("metrics.csv")).unwrap();
-    assert!(csv
-        .lines()
-        .next()
-        .unwrap()
-        .ends_with(",train_grad_norm,vertex_power"));
+    assert!(csv.lines().next().unwrap().ends_with(",train_grad_norm"));
+    let lr = |csv: &str, row: usize| -> f64 {
+        let line = csv.lines().nth(row).unwrap();
+        line.split(',').nth(2).unwrap().parse().unwrap()
+    };
+    assert_eq!((lr(&csv, 1), lr(&csv, 2)), (1e-3, 5.5e-4), "{csv}");
+    let ck = model::load_checkpoint(&naive.join("last.garnet")).unwrap();
+    assert_eq!(ck.state.max_grad_norm, Some(100.0));
 
-    // The same cosine step by step: a single epoch already ends below its start rate.
+    // The same cosine step by step, after a warm-up epoch: the second epoch already ends
+    // below its start rate.
     let per_step = tmp.path().join("per-step");
-    let per_step_args = ["--batch", "1", "--cosine-to", "1e-4", "--cosine-per-step"];
-    let log = ok(&train_args(data, "naive", "1", &per_step, &per_step_args));
-    assert!(
-        log.contains("cosine to 0.0001 at epoch 1, from epoch 0, step by step"),
-        "{log}"
-    );
-    let csv = std::fs::read_to_string(per_step.join("metrics.csv")).unwrap();
-    let lr: f64 = csv
-        .lines()
-        .nth(1)
-        .unwrap()
-        .split(',')
-        .nth(2)
-        .unwrap()
-        .parse()
-        .unwrap();
-    assert!(lr > 1e-4 && lr < 1e-3, "{csv}");
-    let err = fails(&train_args(
+    let per_step_recipe = recipe(
+        tmp.path(),
+        "per-step",
         data,
         "naive",
-        "1",
-        &per_step,
-        &["--cosine-per-step"],
-    ));
-    assert!(err.contains("--cosine-to"), "{err}");
+        2,
+        "batch = 1\nwarmup_epochs = 1\ncosine_to = 1e-4\nper_step = true",
+        "",
+    );
+    ok_v(train(&per_step_recipe, &per_step, &[]));
+    let csv = std::fs::read_to_string(per_step.join("metrics.csv")).unwrap();
+    assert_eq!(lr(&csv, 1), 1e-3, "{csv}");
+    assert!(lr(&csv, 2) > 1e-4 && lr(&csv, 2) < 1e-3, "{csv}");
+    let bad = recipe(tmp.path(), "bad", data, "naive", 1, "per_step = true", "");
+    let err = fails_v(train(&bad, &per_step, &[]));
+    assert!(
+        err.contains("bad.toml") && err.contains("per_step needs cosine_to"),
+        "{err}"
+    );
 
     // Table 1 / Table 2 / precision curves.
     let eval = tmp.path().join("eval");
@@ -219,7 +209,7 @@ fn train_resume_eval_and_drape() {
         args.extend_from_slice(flags);
         garnet(&args)
     };
-    assert!(export(&shipped, &["--max-strain=1000"]).status.success());
+    assert!(export(&shipped, &[]).status.success());
     let size = |p: &Path| std::fs::metadata(p).unwrap().len();
     assert!(
         size(&shipped) * 2 < size(&best),
@@ -230,37 +220,23 @@ fn train_resume_eval_and_drape() {
     let card = std::fs::read_to_string(shipped.with_extension("md")).unwrap();
     for needle in [
         "GarNet-local for the tshirt",
-        "garnet train --data",
-        "--variant local",
+        "trained from scratch by `garnet train --recipe",
+        "local.toml",
+        "variant = \"local\"",
         "| GarNet-local |",
         "| DQS warp (the input M) |",
         "best validation E_dist",
-        "every other training sample mirrored left-right",
-        "learning rate by epoch (from the run's metrics.csv): 1.0e-3 (epochs 1-3)",
-        // The best checkpoint is epoch 2's, before the resumed run changed the loss.
-        "- loss: L_vertex (mean of squared distances) + 1 L_pen",
-        "L_vertex averaged, by epoch (from the run's metrics.csv): squared distances \
-         (epochs 1-2), distances (epoch 3)",
-        // The drapes it was trained on (from the run's log), those the export's filter
-        // passes, and its metrics on the test drapes that pass it.
-        "2 training samples of this garment, 2 of them drapes with strain p99 at most 1000%",
-        "samples trained on per epoch (from the run's metrics.csv): 2 (epochs 1-3)",
+        "- loss: 1 L_vertex (squared) + 1 L_pen",
+        // The drapes it was trained on, and its metrics on the test drapes that pass the
+        // recipe's filter.
+        "2 training samples of this garment, trained on the 2 of them that are drapes with strain p99 at most 1000%",
         "| GarNet-local, drapes with strain p99 at most 1000% |",
         "| DQS warp, drapes with strain p99 at most 1000% |",
-        "--max-strain 1000`.",
     ] {
         assert!(card.contains(needle), "{needle} missing:\n{card}");
     }
-    // A bad filter is refused before anything is written.
     let bad_out = tmp.path().join("bad.garnet");
-    let refused = export(&bad_out, &["--max-slide=-1"]);
-    let err = String::from_utf8_lossy(&refused.stderr);
-    assert!(
-        !refused.status.success() && err.contains("--max-slide"),
-        "{err}"
-    );
-    assert!(!bad_out.exists());
-    let refused = export(&tmp.path().join("model.bin"), &["--at-rest"]);
+    let refused = export(&tmp.path().join("model.bin"), &[]);
     assert!(!refused.status.success());
     let err = String::from_utf8_lossy(&refused.stderr);
     assert!(!err.contains("panicked"), "{err}");
@@ -281,7 +257,7 @@ fn train_resume_eval_and_drape() {
     assert!(export_twin(&twin, "test").status.success());
     let card = std::fs::read_to_string(twin.with_extension("md")).unwrap();
     for needle in [
-        format!("(`{}`, spec", twin_data.display()),
+        format!("(`{}`)", twin_data.display()),
         format!("split of 'model-cli', `{}`", data.display()),
         format!("--train-data {} --out", twin_data.display()),
     ] {
@@ -362,8 +338,19 @@ fn train_and_eval_leave_out_drapes_not_at_rest_or_overstretched() {
     let data = dataset();
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("filtered");
-    let train = |extra: &[&str]| owned(&train_args(data, "naive", "1", &out, extra));
-    let log = ok(&as_str(&train(&["--max-strain", "1000"])));
+    let with_drapes = |name: &str, drapes: &str| {
+        let file = recipe(
+            tmp.path(),
+            name,
+            data,
+            "naive",
+            1,
+            "",
+            &format!("[drapes]\n{drapes}\n"),
+        );
+        train(&file, &out, &[])
+    };
+    let log = ok_v(with_drapes("strain", "max_strain_pct = 1000.0"));
     assert!(
         log.contains("training on drapes with strain p99 at most 1000% only: left out 0"),
         "{log}"
@@ -382,38 +369,40 @@ fn train_and_eval_leave_out_drapes_not_at_rest_or_overstretched() {
         md.contains("Only drapes with strain p99 at most 1000%") && md.contains("| tshirt |"),
         "{md}"
     );
+    let json = std::fs::read_to_string(tmp.path().join("results.json")).unwrap();
+    assert!(
+        json.contains("\"name\": \"model-cli\"") && json.contains("\"spec_sha256\""),
+        "{json}"
+    );
     let err = fails(&as_str(&eval(&["--at-rest"])));
     assert!(
         err.contains("no 'tshirt' sample of split 'test' is one of the drapes at rest"),
         "{err}"
     );
     // Five settling steps: no drape of this dataset is at rest, and every one is strained.
-    let err = fails(&as_str(&train(&["--at-rest"])));
-    assert!(
-        err.contains("none of the 2 samples") && err.contains("--at-rest"),
-        "{err}"
-    );
-    let err = fails(&as_str(&train(&["--max-strain", "0"])));
+    let err = fails_v(with_drapes("rest", "at_rest = true"));
+    assert!(err.contains("none of the 2 samples"), "{err}");
+    let err = fails_v(with_drapes("zero", "max_strain_pct = 0.0"));
     assert!(err.contains("strain p99 at most 0%"), "{err}");
-    let err = fails(&as_str(&train(&["--max-strain=-1"])));
-    assert!(err.contains("--max-strain"), "{err}");
-    // Every garment settles onto the body a little: none slid 0 cm, all under 10 m.
-    let err = fails(&as_str(&train(&["--max-slide", "0"])));
+    let err = fails_v(with_drapes("negative", "max_strain_pct = -1.0"));
     assert!(
-        err.contains("whose garment slid at most 0 cm") && err.contains("--max-slide"),
+        err.contains("negative.toml") && err.contains("max_strain_pct"),
         "{err}"
     );
+    // Every garment settles onto the body a little: none slid 0 cm, all under 10 m.
+    let err = fails_v(with_drapes("slide", "max_slide_cm = 0.0"));
+    assert!(err.contains("whose garment slid at most 0 cm"), "{err}");
     ok(&as_str(&eval(&["--max-slide", "1000"])));
-    let err = fails(&as_str(&train(&["--max-slide=-1"])));
+    let err = fails(&as_str(&eval(&["--max-slide=-1"])));
     assert!(err.contains("--max-slide"), "{err}");
-    let err = fails(&as_str(&train(&["--vertex-power", "3"])));
+    let err = fails_v(with_drapes("unknown", "mirror = true"));
     assert!(
-        err.contains("the power of L_vertex's distances must be in [1, 2], got 3"),
+        err.contains("unknown.toml") && err.contains("mirror"),
         "{err}"
     );
 }
 
-/// Regression (session 26): a run on a dataset still being generated kept comparing its
+/// Regression: a run on a dataset still being generated kept comparing its
 /// best validation E_dist with a figure measured before the validation split had grown.
 #[test]
 fn best_starts_afresh_when_the_validation_split_grows() {
@@ -423,10 +412,11 @@ fn best_starts_afresh_when_the_validation_split_grows() {
     let generate = |shards: &str| generate_in(tmp.path(), &spec, &["--shard", shards]);
     let data = generate("0-4");
     let run = tmp.path().join("run");
-    let log = ok(&train_args(&data, "naive", "1", &run, &[]));
+    let file = recipe(tmp.path(), "naive", &data, "naive", 1, "", "");
+    let log = ok_v(train(&file, &run, &[]));
     assert!(log.contains("(1 validation)"), "{log}");
     generate("5");
-    let log = ok(&train_args(&data, "naive", "2", &run, &["--resume"]));
+    let log = ok_v(train(&file, &run, &["--resume", "--epochs", "2"]));
     assert!(
         log.contains("(2 validation)")
             && log.contains("was measured on another validation set")
@@ -434,7 +424,7 @@ fn best_starts_afresh_when_the_validation_split_grows() {
         "{log}"
     );
     // Resumed again on the same drapes, it keeps its best.
-    let log = ok(&train_args(&data, "naive", "3", &run, &["--resume"]));
+    let log = ok_v(train(&file, &run, &["--resume", "--epochs", "3"]));
     assert!(!log.contains("another validation set"), "{log}");
 }
 
@@ -458,29 +448,36 @@ fn drape_and_eval_refuse_what_does_not_fit() {
     ]);
     assert!(err.contains(s(&template)), "{err}");
     // No such garment in the dataset.
-    let err = fails(&[
-        "train",
-        "--data",
-        s(data),
-        "--garment",
-        "jeans",
-        "--epochs",
-        "1",
-    ]);
+    let jeans = recipe(tmp.path(), "jeans", data, "naive", 1, "", "");
+    std::fs::write(
+        &jeans,
+        std::fs::read_to_string(&jeans)
+            .unwrap()
+            .replace("\"tshirt\"", "\"jeans\""),
+    )
+    .unwrap();
+    let err = fails_v(train(&jeans, &tmp.path().join("j"), &[]));
     assert!(err.contains("jeans") && err.contains("tshirt"), "{err}");
+    // A missing recipe.
+    let err = fails(&["train", "--recipe", "no-such-recipe.toml"]);
+    assert!(err.contains("no-such-recipe.toml"), "{err}");
     // A missing model file.
     let err = fails(&["eval", "--data", s(data), "--model", "nope.garnet"]);
     assert!(err.contains("nope.garnet"), "{err}");
     // Bodies posed another way than the network learned from: a network that learned from
     // DQS bodies on this dataset (LBS bodies), or draped in one run with one trained on it.
     let naive = tmp.path().join("naive");
-    ok(&train_args(data, "naive", "1", &naive, &[]));
+    ok_v(train(
+        &recipe(tmp.path(), "naive", data, "naive", 1, "", ""),
+        &naive,
+        &[],
+    ));
     let trained = naive.join("best.garnet");
     let dqs = tmp.path().join("dqs-naive.garnet");
     let ck = model::load_checkpoint(&trained).unwrap();
     let setup = ck.setup.clone().with_body_skinning("dqs").unwrap();
     let network = ck.model(&burn::prelude::Device::flex()).unwrap();
-    model::save_checkpoint(&dqs, &network, None, &setup, &ck.loss, &ck.state).unwrap();
+    model::save_checkpoint(&dqs, &network, None, &setup, &ck.loss, &ck.state, None).unwrap();
     let err = fails(&["eval", "--data", s(data), "--model", s(&dqs)]);
     assert!(
         err.contains("dqs-naive.garnet")
@@ -542,7 +539,7 @@ fn check_saved_drapes(dir: &Path, report: &str) {
 }
 
 #[test]
-fn train_takes_the_network_widths_from_a_config_file() {
+fn train_takes_the_network_widths_from_its_recipe() {
     let data = dataset();
     let tmp = tempfile::tempdir().unwrap();
     // The run's header: "training GarNet-naive[ +extensions] (N parameters) on ...".
@@ -554,22 +551,15 @@ fn train_takes_the_network_widths_from_a_config_file() {
         let count = after.split('(').nth(1).expect("a parameter count");
         count.split(' ').next().unwrap().parse().unwrap()
     };
-    let run = |name: &str, extra: &[&str]| {
-        let out = tmp.path().join(name);
-        let mut a = train_args(data, "naive", "1", &out, extra);
-        a.extend_from_slice(&["--max-samples", "2"]);
-        owned(&a)
+    let run = |name: &str, network: &str| {
+        let file = recipe(tmp.path(), name, data, "naive", 1, "", network);
+        train(&file, &tmp.path().join(name), &["--max-samples", "2"])
     };
-    let default = params(&ok(&as_str(&run("default", &[]))));
-    let config = tmp.path().join("narrow.json");
-    std::fs::write(
-        &config,
-        r#"{"fusion": [16, 8], "variant": "Local", "body_contact": true, "rest_input": true}"#,
-    )
-    .unwrap();
-    let log = ok(&as_str(&run("narrow", &["--config", s(&config)])));
-    // The file's fusion widths and extra inputs, the command line's variant: fewer
-    // parameters than the default Naive, still a Naive network, named with its extensions.
+    let default = params(&ok_v(run("default", "")));
+    let narrow = "[network]\nfusion = [16, 8]\nbody_contact = true\nrest_input = true\n";
+    let log = ok_v(run("narrow", narrow));
+    // The recipe's fusion widths and extra inputs: fewer parameters than the default
+    // Naive, named with its extensions.
     assert!(
         log.contains("training GarNet-naive +contact +rest ("),
         "{log}"
@@ -604,242 +594,19 @@ fn train_takes_the_network_widths_from_a_config_file() {
     assert!(out.contains("GarNet-naive +contact +rest"), "{out}");
     let draped = geom::io::read_mesh(tmp.path().join("d.glb")).unwrap();
     assert!(draped.vertices.iter().all(|v| v.is_finite()));
-    // An unknown field or a wrong type names the file and the field.
-    std::fs::write(&config, r#"{"fusion_widths": [16]}"#).unwrap();
-    let err = fails(&as_str(&run("bad", &["--config", s(&config)])));
+    // An unknown field, a wrong type or an empty width list names the file and the field.
+    let err = fails_v(run("unknown", "[network]\nfusion_widths = [16]\n"));
     assert!(
-        err.contains("narrow.json") && err.contains("fusion_widths") && err.contains("fusion"),
+        err.contains("unknown.toml") && err.contains("fusion_widths"),
         "{err}"
     );
-    std::fs::write(&config, r#"{"fusion": 16}"#).unwrap();
-    let err = fails(&as_str(&run("bad", &["--config", s(&config)])));
-    assert!(err.contains("narrow.json") && err.contains("type"), "{err}");
-    std::fs::write(&config, r#"{"fusion": []}"#).unwrap();
-    let err = fails(&as_str(&run("bad", &["--config", s(&config)])));
+    let err = fails_v(run("type", "[network]\nfusion = 16\n"));
+    assert!(err.contains("type.toml") && err.contains("fusion"), "{err}");
+    let err = fails_v(run("empty", "[network]\nfusion = []\n"));
     assert!(
-        err.contains("narrow.json") && err.contains("fusion"),
+        err.contains("empty.toml") && err.contains("fusion"),
         "{err}"
     );
-}
-
-/// `garnet average` of two epochs' checkpoints kept by `train --keep-epochs`: a checkpoint
-/// that exports with a card naming the averaged epochs; checkpoints of another variant are
-/// refused.
-#[test]
-fn average_writes_a_checkpoint_that_exports() {
-    let data = dataset();
-    let tmp = tempfile::tempdir().unwrap();
-    let run = tmp.path().join("naive");
-    ok(&train_args(data, "naive", "2", &run, &["--keep-epochs"]));
-    let snapshots: Vec<PathBuf> = (1..=2)
-        .map(|e| run.join(format!("epoch-{e}.garnet")))
-        .collect();
-    for (e, snap) in snapshots.iter().enumerate() {
-        assert_eq!(model::load_checkpoint(snap).unwrap().state.epoch, e + 1);
-    }
-    let mean = tmp.path().join("mean.garnet");
-    let log = ok(&[
-        "average",
-        "--models",
-        s(&snapshots[0]),
-        s(&snapshots[1]),
-        "--out",
-        s(&mean),
-    ]);
-    assert!(log.contains("the mean of 2 networks"), "{log}");
-    // Three networks of one variant: each row names its file (Tables 1 and 2 and the one
-    // motion of the split); the DQS row stays one.
-    let eval = tmp.path().join("eval");
-    let mut args = vec!["eval", "--data", s(data), "--model"];
-    args.extend([s(&snapshots[0]), s(&snapshots[1]), s(&mean)]);
-    args.extend(["--out", s(&eval)]);
-    let md = ok(&args);
-    for model in [&snapshots[0], &snapshots[1], &mean] {
-        let row = format!("| tshirt | GarNet-naive ({}) |", model.display());
-        assert_eq!(md.matches(&row).count(), 3, "{row}\n{md}");
-    }
-    assert_eq!(md.matches("| tshirt | DQS |").count(), 1, "{md}");
-    // The export's filter only adds the card's rows on the test drapes it passes: the
-    // mean (no metrics.csv beside it) trained on every drape, as its record says (a
-    // regression: the card said it trained only on the drapes the export's filter passes).
-    let card = exported_card(
-        &mean,
-        data,
-        &tmp.path().join("models").join("tshirt-naive.garnet"),
-        &["--max-strain", "1000"],
-    );
-    for needle in [
-        "- weights: the mean of the networks of epochs 1-2 (`garnet average`)",
-        "; then garnet average --models",
-        "2 training samples of this garment, trained on every one of them; validation",
-        "- progress: the networks averaged are of epochs 1-2; the file records the last one's \
-         progress: 2 epochs",
-        "| GarNet-naive, drapes with strain p99 at most 1000% |",
-    ] {
-        assert!(card.contains(needle), "{needle} missing:\n{card}");
-    }
-
-    let local = one_epoch_checkpoint(data, "local", &tmp.path().join("local"));
-    let err = fails(&[
-        "average",
-        "--models",
-        s(&snapshots[0]),
-        s(&local),
-        "--out",
-        s(&mean),
-    ]);
-    assert!(
-        err.contains("not averageable") && err.contains("last.garnet"),
-        "{err}"
-    );
-    let err = fails(&["average", "--models", s(&snapshots[0]), "--out", s(&mean)]);
-    assert!(err.contains("--models"), "{err}");
-
-    // Weights: a weighted combination (here an extrapolation) that the card spells out;
-    // weights that do not sum to 1 are refused and write nothing.
-    let combined = tmp.path().join("combined.garnet");
-    let pair = [s(&snapshots[0]), s(&snapshots[1])];
-    let log = ok(&[
-        "average",
-        "--models",
-        pair[0],
-        pair[1],
-        "--weights",
-        "-0.5,1.5",
-        "--out",
-        s(&combined),
-    ]);
-    assert!(
-        log.contains("the combination with weights [-0.5, 1.5]"),
-        "{log}"
-    );
-    let card = exported_card(
-        &combined,
-        data,
-        &tmp.path().join("models").join("tshirt-naive-x.garnet"),
-        &[],
-    );
-    assert!(
-        card.contains("the combination -0.5 x epoch 1 + 1.5 x epoch 2 of networks"),
-        "{card}"
-    );
-    let bad = tmp.path().join("bad.garnet");
-    let err = fails(&[
-        "average",
-        "--models",
-        pair[0],
-        pair[1],
-        "--weights",
-        "0.5,0.6",
-        "--out",
-        s(&bad),
-    ]);
-    assert!(err.contains("sum to"), "{err}");
-    assert!(!bad.exists());
-}
-
-/// Exports `model` as `out` with `data`'s test metrics and the drape filter flags `filter`,
-/// and returns the model card written beside it.
-fn exported_card(model: &Path, data: &Path, out: &Path, filter: &[&str]) -> String {
-    let mut args = vec![
-        "export",
-        "--model",
-        s(model),
-        "--data",
-        s(data),
-        "--out",
-        s(out),
-    ];
-    args.extend_from_slice(filter);
-    ok(&args);
-    std::fs::read_to_string(out.with_extension("md")).unwrap()
-}
-
-/// `garnet grow`: the grown and the widened checkpoints evaluate as their parent, and `garnet
-/// train --resume` trains the grown one on; narrowing and Naive's convolutions are refused.
-#[test]
-fn grow_keeps_the_drapes_and_trains_on() {
-    let data = dataset();
-    let tmp = tempfile::tempdir().unwrap();
-    let run = tmp.path().join("global");
-    let grown = one_epoch_checkpoint(data, "global", &run);
-    let parent = tmp.path().join("parent.garnet");
-    std::fs::copy(&grown, &parent).unwrap();
-    let log = ok(&[
-        "grow",
-        "--model",
-        s(&parent),
-        "--extra-blocks",
-        "2",
-        "--out",
-        s(&grown),
-    ]);
-    assert!(log.contains("with 2 more blocks"), "{log}");
-    let e_dist = |model: &Path| {
-        let out = tmp.path().join("eval");
-        let report = ok(&[
-            "eval",
-            "--data",
-            s(data),
-            "--split",
-            "test",
-            "--model",
-            s(model),
-            "--out",
-            s(&out),
-        ]);
-        let row = report
-            .lines()
-            .find(|l| l.starts_with("| tshirt | GarNet-global"))
-            .unwrap_or_else(|| panic!("no GarNet row:\n{report}"))
-            .to_string();
-        row.split('|').nth(4).unwrap().trim().to_string()
-    };
-    assert_eq!(e_dist(&parent), e_dist(&grown));
-    // Wider convolutions and fusion drape as before too (up to the rounding of longer sums).
-    let wide = tmp.path().join("wide.garnet");
-    let narrow = tmp.path().join("narrow.garnet");
-    let grow_wide = |conv: &'static str, out: &Path| {
-        let out = s(out).to_string();
-        let args = [
-            "grow",
-            "--model",
-            s(&parent),
-            "--conv-width",
-            conv,
-            "--fusion",
-        ];
-        let mut v = owned(&args);
-        v.extend(["160,64,32".to_string(), "--out".to_string(), out]);
-        v
-    };
-    let args = grow_wide("48", &wide);
-    let log = ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
-    assert!(
-        log.contains("convolutions 48 features wide, fusion widths [160, 64, 32]"),
-        "{log}"
-    );
-    assert_eq!(e_dist(&parent), e_dist(&wide));
-    let args = grow_wide("16", &narrow);
-    let err = fails(&args.iter().map(String::as_str).collect::<Vec<_>>());
-    assert!(err.contains("can only be widened"), "{err}");
-    let log = ok(&train_args(data, "global", "2", &run, &["--resume"]));
-    assert!(
-        log.contains("GarNet-global +2 blocks") && log.contains("epoch 2"),
-        "{log}"
-    );
-
-    let naive = one_epoch_checkpoint(data, "naive", &tmp.path().join("naive"));
-    let err = fails(&[
-        "grow",
-        "--model",
-        s(&naive),
-        "--extra-blocks",
-        "1",
-        "--out",
-        s(&tmp.path().join("x.garnet")),
-    ]);
-    assert!(err.contains("Naive has no mesh convolutions"), "{err}");
 }
 
 /// A run stopped inside an epoch (here by a damaged shard at its second batch) resumes from
@@ -851,40 +618,41 @@ fn train_resumes_an_epoch_stopped_inside() {
     let one_a_shard = SPEC.replace("shard_size = 2", "shard_size = 1");
     let data = generate_in(tmp.path(), &one_a_shard, &["--jobs", "2"]);
     let set = dataset::Dataset::open(&data).unwrap();
-    let train = set.select(Some("train"), Some("tshirt")).unwrap();
+    let train_samples = set.select(Some("train"), Some("tshirt")).unwrap();
     let order = Order::Shuffled { seed: 0, epoch: 0 };
-    let second = dataset::batches::epoch_order(&set, &train, order)[1];
+    let second = dataset::batches::epoch_order(&set, &train_samples, order)[1];
     let shard = set.manifest().sample(second).unwrap().shard;
     let shard = data.join(format!("shards/shard-{shard:06}.safetensors"));
     let whole_bytes = std::fs::read(&shard).unwrap();
 
-    let run = |out: &Path, extra: &[&str]| {
-        let mut a = train_args(&data, "local", "1", out, &["--batch", "1"]);
-        a.extend_from_slice(extra);
-        owned(&a)
-    };
+    let every_step = recipe(
+        tmp.path(),
+        "local",
+        &data,
+        "local",
+        1,
+        "batch = 1\ncheckpoint_minutes = 1e-6",
+        "",
+    );
+    let run = |out: &Path, extra: &[&str]| train(&every_step, out, extra);
     let whole = tmp.path().join("whole");
-    ok(&as_str(&run(&whole, &[])));
+    ok_v(run(&whole, &[]));
 
     let stopped = tmp.path().join("stopped");
     let mut damaged = whole_bytes.clone();
     let n = damaged.len();
     damaged[n - 50] ^= 0x40;
     std::fs::write(&shard, &damaged).unwrap();
-    let err = fails(&as_str(&run(&stopped, &["--checkpoint-minutes", "1e-6"])));
+    let err = fails_v(run(&stopped, &[]));
     assert!(err.contains("checksum"), "{err}");
     let mid = stopped.join("mid-epoch.garnet");
     assert!(mid.is_file() && !stopped.join("last.garnet").exists());
     std::fs::write(&shard, &whole_bytes).unwrap();
 
-    let err = fails(&as_str(&run(&stopped, &["--resume", "--seed", "5"])));
-    assert!(
-        err.contains("inside epoch 1 after 1 batches of another training set")
-            && err.contains("seed 0")
-            && err.contains("seed 5"),
-        "{err}"
-    );
-    let log = ok(&as_str(&run(&stopped, &["--resume"])));
+    // Another shuffle is another recipe: the stopped run cannot go on with it.
+    let err = fails_v(run(&stopped, &["--resume", "--seed", "5"]));
+    assert!(err.contains("trained by another recipe"), "{err}");
+    let log = ok_v(run(&stopped, &["--resume"]));
     assert!(log.contains("inside epoch 1, after 1 batches"), "{log}");
     assert!(!mid.exists() && stopped.join("last.garnet").is_file());
     // The row without its wall time (the fourth column).
@@ -900,40 +668,46 @@ fn train_resumes_an_epoch_stopped_inside() {
     // A run started afresh in the folder removes a stopped epoch left there, so that a later
     // --resume cannot go back to it.
     std::fs::copy(stopped.join("last.garnet"), &mid).unwrap();
-    let log = ok(&as_str(&run(&stopped, &[])));
+    let log = ok_v(run(&stopped, &[]));
     assert!(log.contains("removed") && !mid.exists(), "{log}");
 }
 
-/// `garnet train` of `variant` on `data`'s T-shirts for one epoch into `run`: its
-/// `last.garnet`.
-fn one_epoch_checkpoint(data: &Path, variant: &str, run: &Path) -> PathBuf {
-    ok(&train_args(data, variant, "1", run, &[]));
-    run.join("last.garnet")
+/// Writes `dir/NAME.toml`: a recipe of `variant` on `data`'s T-shirts for `epochs` epochs,
+/// with the `schedule` lines in its `[schedule]` and the `sections` after it; returns its
+/// path.
+fn recipe(
+    dir: &Path,
+    name: &str,
+    data: &Path,
+    variant: &str,
+    epochs: usize,
+    schedule: &str,
+    sections: &str,
+) -> PathBuf {
+    let path = dir.join(format!("{name}.toml"));
+    let text = format!(
+        "format = 1\ngarment = \"tshirt\"\nvariant = \"{variant}\"\ndata = {data:?}\n\n\
+         [schedule]\nepochs = {epochs}\n{schedule}\n\n{sections}"
+    );
+    std::fs::write(&path, text).unwrap();
+    path
 }
 
-/// `garnet train` on `data`'s T-shirts with `variant` for `epochs` into `out`, then `extra`.
-fn train_args<'a>(
-    data: &'a Path,
-    variant: &'a str,
-    epochs: &'a str,
-    out: &'a Path,
-    extra: &[&'a str],
-) -> Vec<&'a str> {
-    let mut a = vec![
-        "train",
-        "--data",
-        s(data),
-        "--garment",
-        "tshirt",
-        "--variant",
-        variant,
-        "--epochs",
-        epochs,
-        "--out",
-        s(out),
-    ];
+/// `garnet train --recipe RECIPE --out OUT` and `extra`.
+fn train(recipe: &Path, out: &Path, extra: &[&str]) -> Vec<String> {
+    let mut a = vec!["train", "--recipe", s(recipe), "--out", s(out)];
     a.extend_from_slice(extra);
-    a
+    owned(&a)
+}
+
+/// [`ok`] of an owned command line.
+fn ok_v(v: Vec<String>) -> String {
+    ok(&as_str(&v))
+}
+
+/// [`fails`] of an owned command line.
+fn fails_v(v: Vec<String>) -> String {
+    fails(&as_str(&v))
 }
 
 fn owned(v: &[&str]) -> Vec<String> {
@@ -974,30 +748,26 @@ fn bench_model_reports_every_variant_against_the_dqs_warp() {
     assert!(out.contains("faster than the simulator"), "{out}");
 }
 
-/// `--config` times networks of a file's widths and inputs: the same-drape rows compare
-/// the paper's GarNet-Local with the file's (here deeper, with the body-contact and
-/// template-vertex inputs), and the parameter counts are the file's.
+/// `--recipe` times networks of a recipe's widths and inputs: the same-drape rows compare
+/// the paper's GarNet-Local with the recipe's (here wider, with the body-contact and
+/// template-vertex inputs), and the parameter counts are the recipe's.
 #[test]
-fn bench_model_times_the_networks_of_a_config_file() {
+fn bench_model_times_the_networks_of_a_recipe() {
     let tmp = tempfile::tempdir().unwrap();
-    let file = tmp.path().join("net.json");
-    std::fs::write(
-        &file,
-        r#"{"convs_per_block": 2, "body_contact": true, "rest_input": true}"#,
-    )
-    .unwrap();
-    let args = |config: &Path| small_bench_model(&["--config", s(config)]);
+    let network = "[network]\nconv_width = 48\nbody_contact = true\nrest_input = true\n";
+    let file = recipe(tmp.path(), "net", Path::new("d"), "local", 1, "", network);
+    let args = |config: &Path| small_bench_model(&["--recipe", s(config)]);
     let out = ok(&as_str(&args(&file)));
-    assert!(out.contains("net.json"), "{out}");
+    assert!(out.contains("net.toml"), "{out}");
     for name in ["GarNet-local", "GarNet-local +contact +rest"] {
         assert!(
             out.contains(&format!("same drape: {name} with the push-out")),
             "{out}"
         );
     }
-    // Twice the mesh convolutions: more parameters than the defaults in the Local and
-    // Global rows; Naive has none, and gains only the template vertices' 3 inputs to its
-    // first 64-wide layer (the synthetic rows leave the body contact out).
+    // Wider mesh convolutions: more parameters than the defaults in the Local and Global
+    // rows; Naive has none, and gains only the template vertices' 3 inputs to its first
+    // 64-wide layer (the synthetic rows leave the body contact out).
     let params = |out: &str, variant: &str| -> usize {
         let row = out
             .lines()
@@ -1012,11 +782,18 @@ fn bench_model_times_the_networks_of_a_config_file() {
         params(&out, "| naive |"),
         params(&defaults, "| naive |") + 3 * 64
     );
-    let bad = tmp.path().join("bad.json");
-    std::fs::write(&bad, r#"{"conv_widht": 64}"#).unwrap();
+    let bad = recipe(
+        tmp.path(),
+        "bad",
+        Path::new("d"),
+        "local",
+        1,
+        "",
+        "[network]\nconv_widht = 64\n",
+    );
     let err = fails(&as_str(&args(&bad)));
     assert!(
-        err.contains("bad.json") && err.contains("conv_widht"),
+        err.contains("bad.toml") && err.contains("conv_widht"),
         "{err}"
     );
 }
@@ -1047,4 +824,41 @@ fn main_job_drapes_the_three_shipped_models() {
         assert!(png.is_file(), "{}", png.display());
     }
     assert!(tmp.path().join("out/body.glb").is_file());
+}
+
+/// Regression of the library facade: `garnet drape` of the three shipped models on the main
+/// job's body and pose gives the vertices it gave before the drape moved into the library
+/// and the models into their current format (`tests/fixtures/drape-main-job-*.glb`, written
+/// by the earlier build), to within the differences of the CPUs' matrix kernels.
+#[test]
+fn drape_gives_the_vertices_it_gave_before() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = common::repo().join("models");
+    let models = ["tshirt", "sweater", "jeans"].map(|g| dir.join(format!("{g}-local.garnet")));
+    let out = tmp.path().join("drape.glb");
+    let mut args = vec!["drape", "--model"];
+    args.extend(models.iter().map(|m| s(m)));
+    args.extend([
+        "--random-shape",
+        "1",
+        "--pose-procedural",
+        "1",
+        "--out",
+        s(&out),
+    ]);
+    ok(&args);
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
+    for garment in ["tshirt", "sweater", "jeans"] {
+        let name = format!("drape-main-job-{garment}.glb");
+        let before = geom::io::read_mesh(fixtures.join(&name)).unwrap();
+        let now = geom::io::read_mesh(tmp.path().join(format!("drape-{garment}.glb"))).unwrap();
+        assert_eq!(now.faces, before.faces, "{name}");
+        let worst = now
+            .vertices
+            .iter()
+            .zip(&before.vertices)
+            .map(|(a, b)| a.distance(*b))
+            .fold(0.0f32, f32::max);
+        assert!(worst < 1e-5, "{name}: a vertex moved {worst} m");
+    }
 }

@@ -182,8 +182,8 @@ impl InputSpec {
     /// The network inputs of B samples: stream points `[B][P]` of `bodies` `[B][V]`, and the
     /// local tables and the contact features `[B,N,CONTACT_WIDTH]` of them and `warped`
     /// `[B][N]` (metres, one frame) when the spec has them. The contact features take what
-    /// the caller already has of the bodies (`known`: their normals, as a mirrored sample's
-    /// faces wind inwards, and k-d trees), else compute it from the spec's faces.
+    /// the caller already has of the bodies (`known`: their normals and k-d trees), else
+    /// compute it from the spec's faces.
     pub fn inputs(
         &self,
         bodies: &[&[Vec3]],

@@ -1,7 +1,7 @@
 //! Checkpoints: everything a drape needs (config, weights, garment template, body sampling)
 //! and, for resuming training, the optimiser state and the training progress, in one file.
 //!
-//! Format (`.garnet`, format name `garnet-model-1`): one safetensors file with
+//! Format (`.garnet`, format name `garnet-model-2`): one safetensors file with
 //!
 //! | tensor | dtype | shape | holds |
 //! |---|---|---|---|
@@ -13,11 +13,14 @@
 //! | `garment.file` | U8 | `[L3]` | optional: the `.garment` template file M is warped with |
 //! | `body.faces` | U32 | `[F,3]` | optional: the body's triangles (networks with body-contact features) |
 //!
-//! and JSON metadata `format`, `config` ([`GarNetConfig`]), `loss` ([`LossConfig`]),
-//! `state` ([`TrainState`]), `body.n_vertices` (V) and `body.n_centres` (GarNet-Local's kept
-//! points, a prefix of `body.stream`). Parameters
-//! are stored bit for bit, so a reloaded network gives bit-identical outputs. Files are
-//! written to a temporary file and renamed.
+//! and metadata: `format`, `config` ([`GarNetConfig`], JSON), `loss` ([`LossConfig`], JSON),
+//! `state` ([`TrainState`], JSON), `body.n_vertices` (V), `body.n_centres` (GarNet-Local's
+//! kept points, a prefix of `body.stream`), `body.skinning` (`lbs` or `dqs`), optionally
+//! `recipe` (the [`Recipe`] it was trained by, TOML) with `recipe.command`, and `checksum`:
+//! the SHA-256 of every tensor (name, a zero byte, its bytes; in name order), checked on
+//! load, so a file whose weights were damaged is refused. Parameters are stored bit for bit,
+//! so a reloaded network gives bit-identical outputs. Files are written to a temporary file
+//! and renamed.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -30,6 +33,7 @@ use geom::io::le::typed_tensor;
 use glam::Vec3;
 use safetensors::{tensor::TensorView, Dtype, SafeTensors};
 use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
 
 use crate::batch::InputSpec;
 use crate::config::GarNetConfig;
@@ -38,10 +42,11 @@ use crate::error::{ModelError, Result};
 use crate::garnet::GarNet;
 use crate::local::BodySampling;
 use crate::loss::LossConfig;
+use crate::recipe::{Recipe, RecipeRecord};
 use crate::schedule::CosineSchedule;
 
 /// The format name in a checkpoint's metadata.
-pub const FORMAT: &str = "garnet-model-1";
+pub const FORMAT: &str = "garnet-model-2";
 
 /// What a network needs besides its weights: the architecture, the garment template it was
 /// trained for (its vertex count fixes N, its faces the topology) and the body sampling (which
@@ -57,13 +62,9 @@ pub struct ModelSetup {
     /// The garment template file (`.garment` bytes: weights, rig, template body) the
     /// network's input M is warped with, so a checkpoint alone can drape; opaque here.
     pub garment_file: Option<Vec<u8>>,
-    /// Whether the network works in each sample's canonical frame (see [`crate::frame`]);
-    /// true for every new setup, false for checkpoints written before the frame existed.
-    pub canonical_frame: bool,
-    /// How the bodies it learned from were posed: [`BODY_SKINNINGS`] names, `"dqs"` (dual
-    /// quaternions) or `"lbs"` (linear blending), the skinning of the dataset's simulator.
-    /// A body given to the network must be posed the same way. `"dqs"` for checkpoints
-    /// written before it was recorded (every dataset was DQS then).
+    /// How the bodies it learned from were posed: [`BODY_SKINNINGS`] names, `"lbs"` (linear
+    /// blending) or `"dqs"` (dual quaternions), the skinning of the dataset's simulator.
+    /// A body given to the network must be posed the same way.
     pub body_skinning: String,
     /// The body's faces `[F]` (indices below V), which a network with body-contact features
     /// (see [`GarNetConfig::body_contact`]) needs for the body normals; may be absent
@@ -72,7 +73,7 @@ pub struct ModelSetup {
 }
 
 /// The names [`ModelSetup::body_skinning`] may take.
-pub const BODY_SKINNINGS: [&str; 2] = ["dqs", "lbs"];
+pub const BODY_SKINNINGS: [&str; 2] = ["lbs", "dqs"];
 
 /// Fails on a body skinning name not in [`BODY_SKINNINGS`].
 fn known_body_skinning(name: &str) -> Result<()> {
@@ -109,7 +110,6 @@ impl ModelSetup {
             template,
             body_sampling,
             garment_file: None,
-            canonical_frame: true,
             body_skinning: BODY_SKINNINGS[0].into(),
             body_faces: None,
         })
@@ -146,7 +146,7 @@ impl ModelSetup {
                 .variant
                 .has_local()
                 .then_some((self.config.pool_neighbours, self.config.local_neighbours)),
-            canonical_rest: self.canonical_frame.then(|| self.template.vertices.clone()),
+            canonical_rest: Some(self.template.vertices.clone()),
             contact_faces: self
                 .config
                 .body_contact
@@ -204,51 +204,17 @@ pub struct TrainState {
     pub lr: f64,
     /// Best validation E_dist so far, centimetres (`None` before the first validation).
     pub best_e_dist_cm: Option<f32>,
-    /// The validation set `best_e_dist_cm` was measured on (`dataset:garment`), when the
-    /// run named it (see [`crate::Trainer::set_validation_set`]).
-    #[serde(default)]
+    /// The validation set `best_e_dist_cm` was measured on (`dataset:garment:count`), when
+    /// the run named it (see [`crate::Trainer::set_validation_set`]).
     pub validation: Option<String>,
-    /// The epochs of the networks whose mean this network is (see [`crate::average`]);
-    /// empty for a network trained as it is (cleared by the next training epoch).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub averaged_epochs: Vec<usize>,
-    /// The weights of those networks, one per entry of `averaged_epochs`, when they were
-    /// combined with weights (`garnet average --weights`); empty for the plain mean.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub averaged_weights: Vec<f64>,
-    /// The command line of the latest training run (for model cards), when it was given.
-    #[serde(default)]
-    pub command: Option<String>,
-    /// The flags of the latest training run that chose its training drapes (`garnet
-    /// train`'s `--at-rest`, `--max-strain`, `--max-slide`, as `" --at-rest"`), `""` when it
-    /// trained on every drape; `None` where not recorded (a checkpoint written before the
-    /// field existed, or the mean of networks that trained on different drapes).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub train_drapes: Option<String>,
     /// Joint L2 norm the gradients are clipped to (`None`: no clipping).
-    #[serde(default)]
     pub max_grad_norm: Option<f32>,
     /// Learning-rate schedule (`None`: the rate stays as set).
-    #[serde(default)]
     pub schedule: Option<CosineSchedule>,
-    /// Whether every other training sample is mirrored left-right (see [`crate::mirror`]).
-    #[serde(default)]
-    pub mirror: bool,
     /// In a mid-epoch checkpoint, how far epoch `epoch + 1` has gone (see
     /// [`crate::trainer::MID_EPOCH_CHECKPOINT`]); `None` at an epoch's end.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub partial: Option<EpochProgress>,
-}
-
-impl TrainState {
-    /// Records `command` as made after the recorded command line (`"A; then B"`), for a
-    /// checkpoint written from another by `garnet average` or `garnet grow`.
-    pub fn append_command(&mut self, command: &str) {
-        self.command = Some(match self.command.take() {
-            Some(c) => format!("{c}; then {command}"),
-            None => command.to_string(),
-        });
-    }
 }
 
 /// A checkpoint read from disk; [`Checkpoint::model`] and [`Checkpoint::optimizer`] rebuild
@@ -260,6 +226,8 @@ pub struct Checkpoint {
     pub loss: LossConfig,
     /// Training progress.
     pub state: TrainState,
+    /// The recipe it was trained by, when it was trained by one.
+    pub recipe: Option<RecipeRecord>,
     model_bytes: Vec<u8>,
     optimizer_bytes: Option<Vec<u8>>,
 }
@@ -283,8 +251,22 @@ fn json<T: Serialize>(value: &T) -> Result<String> {
     serde_json::to_string(value).map_err(|e| ModelError::InvalidInput(e.to_string()))
 }
 
-/// Writes `model` (any device) with `setup`, `loss`, `state` and optionally the optimiser
-/// state to `path` (atomically: a temporary file, then a rename).
+/// The SHA-256 (lower-case hex) of `tensors` (name, bytes): each name, a zero byte and its
+/// bytes, in name order; what a checkpoint's `checksum` holds.
+fn tensors_checksum<'a>(tensors: impl IntoIterator<Item = (&'a str, &'a [u8])>) -> String {
+    let mut sorted: Vec<_> = tensors.into_iter().collect();
+    sorted.sort_by_key(|(name, _)| *name);
+    let mut hash = Sha256::new();
+    for (name, bytes) in sorted {
+        hash.update(name.as_bytes());
+        hash.update([0u8]);
+        hash.update(bytes);
+    }
+    hash.finalize().iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// Writes `model` (any device) with `setup`, `loss`, `state`, optionally the optimiser state
+/// and the recipe it was trained by to `path` (atomically: a temporary file, then a rename).
 pub fn save_checkpoint(
     path: &Path,
     model: &GarNet,
@@ -292,6 +274,7 @@ pub fn save_checkpoint(
     setup: &ModelSetup,
     loss: &LossConfig,
     state: &TrainState,
+    recipe: Option<&RecipeRecord>,
 ) -> Result<()> {
     let bad = |m: String| ModelError::checkpoint(path, m);
     setup.validate()?;
@@ -356,16 +339,21 @@ pub fn save_checkpoint(
             to_le(f.iter().flatten().copied(), u32::to_le_bytes),
         ));
     }
-    let meta: HashMap<String, String> = HashMap::from([
+    let checksum = tensors_checksum(tensors.iter().map(|(n, _, _, b)| (*n, b.as_slice())));
+    let mut meta: HashMap<String, String> = HashMap::from([
         ("format".into(), FORMAT.into()),
         ("config".into(), json(&setup.config)?),
         ("loss".into(), json(loss)?),
         ("state".into(), json(state)?),
         ("body.n_vertices".into(), s.n_body.to_string()),
         ("body.n_centres".into(), s.n_centres.to_string()),
-        ("canonical_frame".into(), setup.canonical_frame.to_string()),
         ("body.skinning".into(), setup.body_skinning.clone()),
+        ("checksum".into(), checksum),
     ]);
+    if let Some(r) = recipe {
+        meta.insert("recipe".into(), r.recipe.to_toml());
+        meta.insert("recipe.command".into(), r.command.clone());
+    }
     let views = tensors
         .iter()
         .map(|(name, d, shape, bytes)| {
@@ -394,37 +382,32 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint> {
         meta.get(key)
             .ok_or_else(|| bad(format!("missing metadata {key}")))
     };
-    let mut config_json: serde_json::Value =
-        serde_json::from_str(field("config")?).map_err(|e| bad(format!("metadata config: {e}")))?;
-    // Checkpoints written before the input unit existed take positions in metres.
-    if let Some(obj) = config_json.as_object_mut() {
-        obj.entry("input_scale").or_insert(serde_json::json!(1.0));
-        obj.entry("input_centre")
-            .or_insert(serde_json::json!([0.0, 0.0, 0.0]));
-        // Those written before the extra inputs existed take none.
-        obj.entry("rest_input").or_insert(serde_json::json!(false));
-        obj.entry("body_contact")
-            .or_insert(serde_json::json!(false));
-        // Those written before networks could grow have no extra blocks.
-        obj.entry("extra_blocks").or_insert(serde_json::json!(0));
-    }
     let config: GarNetConfig =
-        serde_json::from_value(config_json).map_err(|e| bad(format!("metadata config: {e}")))?;
-    let mut loss_json: serde_json::Value =
-        serde_json::from_str(field("loss")?).map_err(|e| bad(format!("metadata loss: {e}")))?;
-    // Checkpoints written before the loss had a unit were trained in metres.
-    if let Some(obj) = loss_json.as_object_mut() {
-        obj.entry("units_per_metre")
-            .or_insert(serde_json::json!(1.0));
-        // Those written before L_vertex had a power used the paper's squared distance.
-        obj.entry("vertex_power").or_insert(serde_json::json!(2.0));
-    }
+        serde_json::from_str(field("config")?).map_err(|e| bad(format!("metadata config: {e}")))?;
     let loss: LossConfig =
-        serde_json::from_value(loss_json).map_err(|e| bad(format!("metadata loss: {e}")))?;
+        serde_json::from_str(field("loss")?).map_err(|e| bad(format!("metadata loss: {e}")))?;
     let state: TrainState =
         serde_json::from_str(field("state")?).map_err(|e| bad(format!("metadata state: {e}")))?;
+    let recipe = match meta.get("recipe") {
+        None => None,
+        Some(text) => Some(RecipeRecord {
+            recipe: Recipe::parse(text).map_err(|e| bad(format!("metadata recipe: {e}")))?,
+            command: field("recipe.command")?.clone(),
+        }),
+    };
     let st = SafeTensors::deserialize(&bytes).map_err(|e| bad(e.to_string()))?;
     let names = st.names();
+    let computed = tensors_checksum(names.iter().map(|&n| {
+        let data = st.tensor(n).map(|t| t.data()).unwrap_or_default();
+        (n, data)
+    }));
+    if field("checksum")? != &computed {
+        return Err(bad(format!(
+            "its tensors do not match their checksum: the file is damaged (stored {}, \
+             computed {computed})",
+            field("checksum")?
+        )));
+    }
     let data = |name: &str, dtype: Dtype| -> Result<&[u8]> {
         Ok(typed_tensor(&st, name, dtype).map_err(bad)?.data())
     };
@@ -482,17 +465,14 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint> {
         body_sampling,
         garment_file,
         body_faces,
-        canonical_frame: meta.get("canonical_frame").is_some_and(|v| v == "true"),
-        body_skinning: meta
-            .get("body.skinning")
-            .cloned()
-            .unwrap_or_else(|| BODY_SKINNINGS[0].into()),
+        body_skinning: field("body.skinning")?.clone(),
     };
     setup.validate().map_err(|e| bad(e.to_string()))?;
     Ok(Checkpoint {
         setup,
         loss,
         state,
+        recipe,
         model_bytes,
         optimizer_bytes,
     })

@@ -133,14 +133,6 @@ pub struct GarNetConfig {
     /// which vertex it is looking at whatever the pose. Off in the paper's networks.
     #[config(default = false)]
     pub rest_input: bool,
-    /// Our extension (not in the paper): residual blocks `y = x + conv([x; M])` after the
-    /// paper's blocks (no activation outside the sum), each convolution's head weights and
-    /// bias starting at zero, so each block starts as the identity: `garnet grow` adds them
-    /// to a trained network, which then drapes exactly as before and trains on from there.
-    /// Their assignment parameters come from generators of their own, so no other parameter
-    /// depends on this count.
-    #[config(default = 0)]
-    pub extra_blocks: usize,
     /// Width of the global garment feature (a shared layer then max pooling over vertices).
     #[config(default = 256)]
     pub garment_global: usize,
@@ -230,11 +222,6 @@ impl GarNetConfig {
                 self.input_scale, self.input_centre
             )));
         }
-        if !self.variant.has_mesh_conv() && self.extra_blocks > 0 {
-            return Err(ModelError::InvalidInput(
-                "GarNet-Naive has no mesh convolutions to add extra blocks to".into(),
-            ));
-        }
         if self.variant.has_mesh_conv() && (self.conv_blocks == 0 || self.convs_per_block == 0) {
             return Err(ModelError::InvalidInput(
                 "GarNet-Global and -Local need at least one mesh-convolution block".into(),
@@ -252,9 +239,6 @@ impl GarNetConfig {
         }
         if self.rest_input {
             name.push_str(" +rest");
-        }
-        if self.extra_blocks > 0 {
-            name.push_str(&format!(" +{} blocks", self.extra_blocks));
         }
         name
     }

@@ -44,8 +44,6 @@ pub enum Epilogue<'a> {
     Lrelu,
     /// `lrelu(r + y)`.
     ResidualLrelu(&'a [f32]),
-    /// `r + y`.
-    Residual(&'a [f32]),
 }
 
 impl Epilogue<'_> {
@@ -56,11 +54,6 @@ impl Epilogue<'_> {
             Epilogue::ResidualLrelu(r) => {
                 for (v, &r) in y.iter_mut().zip(&r[start..]) {
                     *v = lrelu(r + *v);
-                }
-            }
-            Epilogue::Residual(r) => {
-                for (v, &r) in y.iter_mut().zip(&r[start..]) {
-                    *v += r;
                 }
             }
         }
@@ -453,7 +446,6 @@ pub(crate) mod tests {
             let cases = [
                 (Epilogue::Lrelu, lrelu(y.clone())),
                 (Epilogue::ResidualLrelu(&xs), lrelu(x.clone() + y.clone())),
-                (Epilogue::Residual(&xs), x.clone() + y.clone()),
             ];
             for (epilogue, want) in cases {
                 let got = conv

@@ -3,7 +3,7 @@
 //! ```text
 //! M [B,N,3] -> STN 3x3 -> MLP (global body feature enters every layer) -> point-wise [B,N,P]
 //!   -> (Global, Local) 6 residual blocks of FeaStNet convolutions, each convolution's input
-//!      concatenated with the vertex positions M (then any extra blocks) -> patch-wise [B,N,C]
+//!      concatenated with the vertex positions M -> patch-wise [B,N,C]
 //! [point; patch] -> shared layer -> max over vertices -> global garment feature [B,G]
 //! ```
 
@@ -122,57 +122,6 @@ impl ResBlock {
     }
 }
 
-/// A residual block that grows a trained network (our extension, see
-/// [`GarNetConfig::extra_blocks`]): `y = x + conv([x; M])`, without an activation outside the
-/// sum, so with the convolution's head weights and bias at zero it is the identity.
-#[derive(Module, Debug)]
-pub struct ExtraBlock {
-    /// The convolution `C+3 -> C`.
-    pub conv: FeaStConv,
-}
-
-/// Offsets the seed of the `i`-th extra block's own generator from the network's.
-const EXTRA_BLOCK_SEED: u64 = 0x6772_6f77_0000_0000;
-
-impl ExtraBlock {
-    /// The `index`-th extra block of a network seeded `seed`, `width` features, `heads`
-    /// heads: assignment parameters drawn as any convolution's from a generator of its own,
-    /// head weights and bias zero (the identity).
-    pub(crate) fn new(
-        width: usize,
-        heads: usize,
-        seed: u64,
-        index: usize,
-        device: &Device,
-    ) -> Self {
-        let mut init = ParamInit::new(seed ^ (EXTRA_BLOCK_SEED + index as u64));
-        let mut conv = FeaStConv::new(width + 3, width, heads, &mut init, device);
-        conv.w = init.scaled(heads * (width + 3), width, 0.0, device);
-        ExtraBlock { conv }
-    }
-
-    /// `x` `[B,N,C]`, `pos` `[B,N,3]` -> `[B,N,C]`.
-    pub fn forward(&self, x: Tensor<3>, pos: Tensor<3>, topo: &TopologyTensors) -> Tensor<3> {
-        if let Some(y) = self.forward_host(&x, &pos, topo) {
-            return y;
-        }
-        x.clone() + conv_with_positions(&self.conv, x, pos, topo)
-    }
-
-    /// [`ExtraBlock::forward`] as plain loops ([`block_rows`]), or `None`.
-    fn forward_host(
-        &self,
-        x: &Tensor<3>,
-        pos: &Tensor<3>,
-        topo: &TopologyTensors,
-    ) -> Option<Tensor<3>> {
-        block_rows(x, pos, topo, |xs, ps, n| {
-            self.conv
-                .forward_rows(xs, ps, n, &topo.host_ring, Epilogue::Residual(xs))
-        })
-    }
-}
-
 /// Garment stream.
 #[derive(Module, Debug)]
 pub struct GarmentStream {
@@ -185,8 +134,6 @@ pub struct GarmentStream {
     pub conv_in: Option<Linear>,
     /// Residual mesh-convolution blocks (empty for GarNet-Naive).
     pub blocks: Vec<ResBlock>,
-    /// Blocks added after them ([`GarNetConfig::extra_blocks`]; usually none).
-    pub extra: Vec<ExtraBlock>,
     /// Shared layer before the max pooling to the global garment feature.
     pub global: Linear,
 }
@@ -219,18 +166,15 @@ impl GarmentStream {
             d = w;
         }
         let p = d;
-        let (conv_in, blocks, extra, d_global) = if cfg.variant.has_mesh_conv() {
+        let (conv_in, blocks, d_global) = if cfg.variant.has_mesh_conv() {
             let c = cfg.conv_width;
             let conv_in = (p != c).then(|| init.hidden(p, c, device));
             let blocks = (0..cfg.conv_blocks)
                 .map(|_| ResBlock::new(c, cfg.convs_per_block, cfg.conv_heads, init, device))
                 .collect();
-            let extra = (0..cfg.extra_blocks)
-                .map(|i| ExtraBlock::new(c, cfg.conv_heads, cfg.seed, i, device))
-                .collect();
-            (conv_in, blocks, extra, p + c)
+            (conv_in, blocks, p + c)
         } else {
-            (None, Vec::new(), Vec::new(), p)
+            (None, Vec::new(), p)
         };
         let global = init.hidden(d_global, cfg.garment_global, device);
         GarmentStream {
@@ -238,7 +182,6 @@ impl GarmentStream {
             mlp,
             conv_in,
             blocks,
-            extra,
             global,
         }
     }
@@ -265,9 +208,6 @@ impl GarmentStream {
                 None => points.clone(),
             };
             for block in &self.blocks {
-                c = block.forward(c, warped.clone(), topo);
-            }
-            for block in &self.extra {
                 c = block.forward(c, warped.clone(), topo);
             }
             Some(c)
@@ -324,7 +264,7 @@ mod tests {
     use rand::{Rng, SeedableRng};
 
     /// The blocks' plain loops (untracked tensors on flex) against the same blocks written
-    /// with burn's ops: residual blocks of one and two convolutions, and an extra block.
+    /// with burn's ops: residual blocks of one and two convolutions.
     #[test]
     fn blocks_on_the_host_match_the_tensor_ops() {
         let device = Device::flex();
@@ -355,10 +295,5 @@ mod tests {
             let got = block.forward_host(&x, &pos, &topo).expect("the host path");
             compare(got, want, "residual block");
         }
-        let mut extra = ExtraBlock::new(c, 8, 1, 0, &device);
-        extra.conv.w = init.hidden(8 * (c + 3), c, &device);
-        let want = x.clone() + conv(&extra.conv, x.clone());
-        let got = extra.forward_host(&x, &pos, &topo).expect("the host path");
-        compare(got, want, "extra block");
     }
 }

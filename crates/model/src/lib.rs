@@ -5,7 +5,7 @@
 //! always compiled in; `cuda` and `wgpu` behind the cargo features of the same names).
 //! Training uses `device.autodiff()`; inference a plain device.
 //!
-//! Units: metres (the loss terms: centimetres, see [`LossConfig::units_per_metre`]). Shapes: `B` samples, `V` body vertices (13380), `P` body points the body
+//! Units: metres (the loss terms: centimetres, see [`LOSS_UNITS_PER_METRE`]). Shapes: `B` samples, `V` body vertices (13380), `P` body points the body
 //! stream sees (a fixed subset, 3345 by default), `N` garment vertices, `F` garment faces, `K`
 //! neighbourhood width; point tensors are `[B,V,3]`, `[B,P,3]`, `[B,N,3]`.
 //!
@@ -34,7 +34,6 @@
 #![warn(missing_docs)]
 
 pub mod alloc;
-pub mod average;
 pub mod batch;
 pub mod bench;
 pub mod body_stream;
@@ -52,13 +51,12 @@ pub mod fusion;
 pub mod garment_stream;
 pub mod garnet;
 pub mod grad_clip;
-pub mod grow;
 mod init;
 pub mod layers;
 pub mod local;
 pub mod loss;
 pub mod metrics_log;
-pub mod mirror;
+pub mod recipe;
 pub mod schedule;
 pub mod stn;
 pub mod synthetic;
@@ -66,10 +64,8 @@ pub mod tensors;
 pub mod topology;
 pub mod train;
 pub mod trainer;
-pub mod widen;
 
 pub use alloc::tune_allocator;
-pub use average::{average_checkpoints, average_networks, combine_networks, AverageReport};
 pub use batch::{Batch, BodyTopology, InputSpec, KnownBodies, NetInputs, Sample};
 pub use checkpoint::{load_checkpoint, save_checkpoint, Checkpoint, ModelSetup, TrainState};
 pub use config::{GarNetConfig, Variant};
@@ -77,16 +73,14 @@ pub use drape::Draper;
 pub use error::{ModelError, Result};
 pub use frame::CanonicalFrame;
 pub use garnet::GarNet;
-pub use grow::{grow_checkpoint, grow_network, GrowPlan};
 pub use init::LEAKY_SLOPE;
 pub use local::{BodySampling, LocalIndices};
-pub use loss::{garnet_loss, LossConfig, LossTerms};
-pub use mirror::MirrorMap;
+pub use loss::{garnet_loss, LossConfig, LossTerms, VertexLoss, LOSS_UNITS_PER_METRE};
+pub use recipe::{Recipe, RecipeRecord};
 pub use schedule::CosineSchedule;
 pub use topology::{GarmentTopology, TopologyTensors};
 pub use train::{adam, evaluate_batch, train_step, Evaluation, StepReport, PAPER_LEARNING_RATE};
 pub use trainer::{EpochReport, Trainer, Validation};
-pub use widen::widen_network;
 
 /// burn's optimiser type used for GarNet (Adam).
 pub use burn::optim::ModuleOptimizer as Optimizer;

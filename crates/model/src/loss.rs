@@ -4,10 +4,9 @@
 //! L = w_vertex L_vertex + w_pen L_pen + w_norm L_norm + w_bend L_bend   (1, 1.0, 0.3, 0.5)
 //! ```
 //!
-//! - `L_vertex = 1/N sum_i |G^G_i - G^P_i|^2` (square centimetres by default, see
-//!   [`LossConfig::units_per_metre`]; lengths below likewise); with
-//!   [`LossConfig::vertex_power`] `p` other than the paper's 2, `1/N sum_i |G^G_i - G^P_i|^p`
-//!   (p = 1: the mean distance that E_dist reports, in centimetres);
+//! - `L_vertex = 1/N sum_i |G^G_i - G^P_i|^2` (square centimetres: every length of the loss
+//!   is in centimetres, [`LOSS_UNITS_PER_METRE`]); with [`VertexLoss::Distance`]
+//!   `1/N sum_i |G^G_i - G^P_i|`, the mean distance that E_dist reports (centimetres);
 //! - `L_pen = 1/N sum_j 1{|G^P_j - G^G_j| < d_tol} ReLU(-n_i . (G^P_j - (B_i + 0.2 e n_i)))`
 //!   (centimetres), with i the body vertex nearest to G^P_j (found on the CPU at every step),
 //!   n_i its unit normal, e the body's mean edge length and d_tol = 0.05 m (5 cm);
@@ -54,20 +53,54 @@ pub struct LossConfig {
     /// mean edge length (0.2).
     #[config(default = 0.2)]
     pub pen_push: f64,
-    /// Length unit of the loss terms, in units per metre: 100 measures L_vertex in cm^2 and
-    /// L_pen, L_bend in cm (as the paper reports its errors); 1 in metres. The paper's weights
-    /// balance the terms only in centimetres: in metres the unit-free L_norm and the linear
-    /// L_pen, L_bend outweigh L_vertex's gradient 10-100 times and the network barely learns
-    /// the drape (see docs/model.md).
-    #[config(default = 100.0)]
-    pub units_per_metre: f64,
-    /// The power p of each vertex's distance that L_vertex averages, in [1, 2]: 2 is the
-    /// paper's squared distance (the network learns the conditional mean drape); 1 the
-    /// distance itself, the quantity E_dist averages (a median-like fit, which a few
-    /// vertices far from their label pull on no harder than the rest). L_vertex is then in
-    /// loss units to the power p (cm^2 or cm).
-    #[config(default = 2.0)]
-    pub vertex_power: f64,
+    /// How L_vertex measures each vertex's distance to its label.
+    #[config(default = "VertexLoss::Squared")]
+    pub vertex_loss: VertexLoss,
+}
+
+/// The loss's length unit, units per metre: L_vertex is in cm^2 (or cm), L_pen and L_bend
+/// in cm, as the paper reports its errors. The paper's weights balance the terms in these
+/// units (in metres the unit-free L_norm and the linear L_pen, L_bend outweigh L_vertex's
+/// gradient 10-100 times; see docs/findings.md).
+pub const LOSS_UNITS_PER_METRE: f64 = 100.0;
+
+/// How L_vertex measures each vertex's distance to its label.
+#[derive(Config, Debug, Copy, PartialEq, Eq)]
+pub enum VertexLoss {
+    /// The paper's squared distance (cm^2): the network learns the conditional mean drape.
+    Squared,
+    /// The distance itself (cm), the quantity E_dist averages: a median-like fit, which a
+    /// few vertices far from their label pull on no harder than the rest.
+    Distance,
+}
+
+impl VertexLoss {
+    /// The power of each vertex's distance that L_vertex averages: 2 or 1.
+    pub fn power(self) -> f64 {
+        match self {
+            VertexLoss::Squared => 2.0,
+            VertexLoss::Distance => 1.0,
+        }
+    }
+
+    /// Lower-case name: `squared` or `distance`.
+    pub fn name(self) -> &'static str {
+        match self {
+            VertexLoss::Squared => "squared",
+            VertexLoss::Distance => "distance",
+        }
+    }
+
+    /// Parses [`VertexLoss::name`].
+    pub fn parse(s: &str) -> Result<VertexLoss> {
+        match s {
+            "squared" => Ok(VertexLoss::Squared),
+            "distance" => Ok(VertexLoss::Distance),
+            _ => Err(ModelError::InvalidInput(format!(
+                "unknown L_vertex kind {s:?} (squared or distance)"
+            ))),
+        }
+    }
 }
 
 /// Loss values of one step or averaged over many (f32; the units of each term).
@@ -75,8 +108,7 @@ pub struct LossConfig {
 pub struct LossTerms {
     /// Weighted sum.
     pub total: f32,
-    /// L_vertex, loss units to the power [`LossConfig::vertex_power`] (cm^2 by default, see
-    /// [`LossConfig::units_per_metre`]).
+    /// L_vertex: cm^2 ([`VertexLoss::Squared`]) or cm ([`VertexLoss::Distance`]).
     pub vertex: f32,
     /// L_pen, loss units (cm).
     pub pen: f32,
@@ -277,7 +309,7 @@ pub fn garnet_loss(
     let pred_points = read_points(pred.clone().detach())?;
     let (nearest, close) =
         penetration_matches(&pred_points, targets, &batch.body_index, cfg.d_tol as f32)?;
-    let vertex = vertex_loss(pred.clone(), target.clone(), cfg.vertex_power);
+    let vertex = vertex_loss(pred.clone(), target.clone(), cfg.vertex_loss.power());
     let pen = penetration_loss(
         pred.clone(),
         batch.body.clone(),
@@ -289,8 +321,8 @@ pub fn garnet_loss(
     );
     let norm = normal_loss(pred.clone(), target.clone(), &topo.faces);
     let bend = bending_loss(pred, target, &topo.bend_pairs);
-    let unit = cfg.units_per_metre;
-    let vertex = vertex * unit.powf(cfg.vertex_power);
+    let unit = LOSS_UNITS_PER_METRE;
+    let vertex = vertex * unit.powf(cfg.vertex_loss.power());
     let pen = pen * unit;
     let bend = bend * unit;
     let weighted = [
@@ -410,17 +442,7 @@ mod tests {
         );
         // Vertices 0 and 1 sit at z = 0, 1 cm under their pushed body points (z = 0.01):
         // 0.01 each; vertices 2 and 3 are > d_tol from their targets and do not count.
-        let cfg = LossConfig::new().with_units_per_metre(1.0);
-        let all = garnet_loss(pred.clone(), &b, &topo, &cfg)
-            .unwrap()
-            .values()
-            .unwrap();
-        close(all.pen, 0.02 / 4.0);
-        close(all.vertex, 0.3125);
-        close(all.norm, tilt);
-        close(all.bend, bend);
-        close(all.total, 0.3125 + 0.005 + 0.3 * tilt + 0.5 * bend);
-        // The default unit, centimetres: lengths x100, L_vertex x1e4, L_norm unchanged.
+        // In centimetres: lengths x100, L_vertex x1e4, L_norm unchanged.
         let cm = garnet_loss(pred.clone(), &b, &topo, &LossConfig::new())
             .unwrap()
             .values()
@@ -433,7 +455,9 @@ mod tests {
             "{cm:?}"
         );
         // L_vertex as the mean distance in centimetres, (0 + 0 + 100 + 50) / 4, weighted 2.
-        let dist_cfg = LossConfig::new().with_vertex_power(1.0).with_vertex(2.0);
+        let dist_cfg = LossConfig::new()
+            .with_vertex_loss(VertexLoss::Distance)
+            .with_vertex(2.0);
         let dist = garnet_loss(pred, &b, &topo, &dist_cfg)
             .unwrap()
             .values()
@@ -449,7 +473,7 @@ mod tests {
     fn penetration_counts_only_close_vertices_on_the_wrong_side() {
         let device = Device::flex();
         let (b, topo) = batch(&device);
-        let cfg = LossConfig::new().with_units_per_metre(1.0);
+        let cfg = LossConfig::new();
         // Vertex 0 3 cm up (within d_tol, 2 cm outside its pushed body point), vertices 2 and
         // 3 2 cm up (1 cm outside): no penalty; vertex 1 stays 1 cm inside: 0.01 / 4.
         let mut p = square().vertices;
@@ -461,7 +485,7 @@ mod tests {
             .values()
             .unwrap()
             .pen;
-        close(pen, 0.01 / 4.0);
+        close(pen, 1.0 / 4.0);
         // Vertex 1 6 cm down: inside, but farther than d_tol from its target: no penalty.
         p[1].z = -0.06;
         let pen = garnet_loss(points_tensor(&[&p], &device), &b, &topo, &cfg)
@@ -478,7 +502,6 @@ mod tests {
         let (b, topo) = batch(&device);
         let pred = points_tensor(&[&prediction()], &device);
         let cfg = LossConfig::new()
-            .with_units_per_metre(1.0)
             .with_norm(0.0)
             .with_bend(0.0)
             .with_pen(0.0);
@@ -486,8 +509,8 @@ mod tests {
             .unwrap()
             .values()
             .unwrap();
-        close(t.total, 0.3125);
-        assert!(t.bend > 0.1 && t.norm > 0.05);
+        close(t.total, 3125.0);
+        assert!(t.bend > 10.0 && t.norm > 0.05);
         assert!(LossConfig::new()
             .with_vertex(0.0)
             .with_pen(0.0)
@@ -497,13 +520,11 @@ mod tests {
             .is_err());
         assert!(LossConfig::new().with_d_tol(-1.0).validate().is_err());
         assert!(LossConfig::new()
-            .with_units_per_metre(0.0)
+            .with_vertex_loss(VertexLoss::Distance)
             .validate()
-            .is_err());
-        for p in [0.5, 2.5, f64::NAN] {
-            assert!(LossConfig::new().with_vertex_power(p).validate().is_err());
-        }
-        assert!(LossConfig::new().with_vertex_power(1.0).validate().is_ok());
+            .is_ok());
+        assert_eq!(VertexLoss::parse("distance").unwrap(), VertexLoss::Distance);
+        assert!(VertexLoss::parse("cubed").is_err());
     }
 
     /// Central differences of the full loss against its autodiff gradient, for every
@@ -512,12 +533,12 @@ mod tests {
     /// L_vertex and with the distance itself.
     #[test]
     fn full_loss_gradient_matches_finite_differences() {
-        for power in [2.0, 1.0] {
-            full_loss_gradient_check(power);
+        for kind in [VertexLoss::Squared, VertexLoss::Distance] {
+            full_loss_gradient_check(kind);
         }
     }
 
-    fn full_loss_gradient_check(vertex_power: f64) {
+    fn full_loss_gradient_check(vertex_loss: VertexLoss) {
         let plain = Device::flex();
         let ad = plain.clone().autodiff();
         let mesh = geom::TriMesh::grid(4, 4, 0.1);
@@ -567,9 +588,7 @@ mod tests {
             contact_faces: None,
             rest_input: None,
         };
-        let cfg = LossConfig::new()
-            .with_units_per_metre(1.0)
-            .with_vertex_power(vertex_power);
+        let cfg = LossConfig::new().with_vertex_loss(vertex_loss);
         let loss_at = |p: &[Vec3]| -> f64 {
             let b = Batch::new(std::slice::from_ref(&sample), &topo, &spec, &plain).unwrap();
             let tt = topo.to_device(&plain);
@@ -604,7 +623,7 @@ mod tests {
                 worst = worst.max(err);
                 assert!(
                     (fd - ad).abs() <= 2e-4 + 2e-2 * ad.abs(),
-                    "power {vertex_power}, vertex {i} coord {c}: finite difference {fd}, autodiff {ad}"
+                    "{vertex_loss:?}, vertex {i} coord {c}: finite difference {fd}, autodiff {ad}"
                 );
             }
         }

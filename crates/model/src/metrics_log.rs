@@ -3,16 +3,15 @@
 //! ```text
 //! epoch,step,lr,seconds,train_samples,train_total,train_vertex,train_pen,train_norm,
 //! train_bend,val_samples,val_total,val_vertex,val_pen,val_norm,val_bend,val_e_dist_cm,
-//! val_e_norm_deg,best,train_grad_norm,vertex_power
+//! val_e_norm_deg,best,train_grad_norm
 //! ```
 //!
-//! Loss terms in the loss's units (cm by default: vertex cm^2, pen and bend cm, norm none;
-//! vertex in cm^p with the epoch's `vertex_power` p, see `LossConfig::vertex_power`);
+//! Loss terms in the loss's units (vertex cm^2, or cm with `VertexLoss::Distance`; pen and
+//! bend cm; norm none);
 //! the `val_*` fields are empty for an epoch without validation; `best` is 1 when the epoch
 //! wrote `best.garnet`; `train_grad_norm` is the epoch's mean joint gradient norm before
 //! clipping. Appending a row drops any rows of that epoch or later (a resumed run rewrites
-//! the epochs after its checkpoint); rows of a log written before a column was added get an
-//! empty field for it. The file is rewritten atomically (temporary file, rename).
+//! the epochs after its checkpoint). A log whose header is not [`HEADER`] is refused. The file is rewritten atomically (temporary file, rename).
 
 use std::path::PathBuf;
 
@@ -23,7 +22,7 @@ use crate::trainer::Validation;
 /// The CSV header line.
 pub const HEADER: &str = "epoch,step,lr,seconds,train_samples,train_total,train_vertex,\
 train_pen,train_norm,train_bend,val_samples,val_total,val_vertex,val_pen,val_norm,val_bend,\
-val_e_dist_cm,val_e_norm_deg,best,train_grad_norm,vertex_power";
+val_e_dist_cm,val_e_norm_deg,best,train_grad_norm";
 
 /// One epoch's row.
 #[derive(Clone, Debug, PartialEq)]
@@ -46,8 +45,6 @@ pub struct MetricsRow {
     pub validation: Option<Validation>,
     /// Whether the epoch wrote the best checkpoint.
     pub is_best: bool,
-    /// The power of the distances L_vertex averaged (2: squared).
-    pub vertex_power: f64,
 }
 
 impl MetricsRow {
@@ -82,7 +79,7 @@ impl MetricsRow {
             None => s.push_str(",,,,,,,,"),
         }
         s.push_str(if self.is_best { "1," } else { "0," });
-        s.push_str(&format!("{},{}", self.grad_norm, self.vertex_power));
+        s.push_str(&self.grad_norm.to_string());
         s
     }
 }
@@ -111,15 +108,19 @@ impl MetricsLog {
                 })
             }
         };
-        let columns = HEADER.split(',').count();
+        let mut lines = old.lines();
+        if let Some(header) = lines.next().filter(|h| *h != HEADER) {
+            return Err(ModelError::InvalidInput(format!(
+                "{}: not a metrics log of this version (header {header:?}); move it away",
+                self.path.display()
+            )));
+        }
         let mut out = String::from(HEADER);
         out.push('\n');
-        for line in old.lines().skip(1) {
+        for line in lines {
             let epoch: Option<usize> = line.split(',').next().and_then(|e| e.parse().ok());
             if epoch.is_some_and(|e| e < row.epoch) {
                 out.push_str(line);
-                let missing = columns.saturating_sub(line.split(',').count());
-                out.push_str(&",".repeat(missing));
                 out.push('\n');
             }
         }
@@ -156,7 +157,6 @@ mod tests {
                 samples: 2,
             }),
             is_best: val,
-            vertex_power: 2.0,
         }
     }
 
@@ -177,24 +177,20 @@ mod tests {
         assert!(lines.iter().all(|l| l.split(',').count() == cols));
         assert!(lines[1].starts_with("1,10,0.001,1.500,8,0.5,0.25,0,0.1,0.2,2,"));
         assert!(lines[2].starts_with("2,20,"));
-        assert!(lines[2].ends_with(",1.25,9.5,1,2.5,2"));
-        assert!(row(4, false).to_csv().ends_with(",,,,,,,,0,2.5,2"));
+        assert!(lines[2].ends_with(",1.25,9.5,1,2.5"));
+        assert!(row(4, false).to_csv().ends_with(",,,,,,,,0,2.5"));
     }
 
     #[test]
-    fn rows_of_an_older_log_get_the_new_columns_empty() {
+    fn a_log_with_another_header_is_refused() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("m.csv");
-        let old_header = HEADER.trim_end_matches(",train_grad_norm,vertex_power");
-        let old_row = row(1, true).to_csv();
-        let old_row = old_row.trim_end_matches(",2.5,2");
-        std::fs::write(&path, format!("{old_header}\n{old_row}\n")).unwrap();
-        MetricsLog::new(path.clone()).append(&row(2, true)).unwrap();
-        let text = std::fs::read_to_string(&path).unwrap();
-        let lines: Vec<&str> = text.lines().collect();
-        assert_eq!(lines[0], HEADER);
-        assert_eq!(lines[1], format!("{old_row},,"));
-        let cols = HEADER.split(',').count();
-        assert!(lines.iter().all(|l| l.split(',').count() == cols));
+        std::fs::write(&path, "epoch,step\n1,10\n").unwrap();
+        let err = MetricsLog::new(path.clone()).append(&row(2, true));
+        assert!(err.unwrap_err().to_string().contains("m.csv"));
+        assert_eq!(
+            std::fs::read_to_string(&path).unwrap(),
+            "epoch,step\n1,10\n"
+        );
     }
 }

@@ -20,8 +20,7 @@ pub struct CosineSchedule {
     /// Epoch the schedule ends at (> `from_epoch`).
     pub to_epoch: usize,
     /// Steps in one epoch, when the rate follows the cosine step by step (`None`: epoch by
-    /// epoch; checkpoints written before this field existed read as `None`).
-    #[serde(default)]
+    /// epoch).
     pub steps_per_epoch: Option<u64>,
 }
 

@@ -40,18 +40,6 @@ impl LossConfig {
                 "loss weights and constants must be finite and >= 0: {self:?}"
             )));
         }
-        if !(self.units_per_metre.is_finite() && self.units_per_metre > 0.0) {
-            return Err(ModelError::InvalidInput(format!(
-                "the loss unit must be a positive number of units per metre, got {}",
-                self.units_per_metre
-            )));
-        }
-        if !(1.0..=2.0).contains(&self.vertex_power) {
-            return Err(ModelError::InvalidInput(format!(
-                "the power of L_vertex's distances must be in [1, 2], got {}",
-                self.vertex_power
-            )));
-        }
         if self.vertex + self.pen + self.norm + self.bend == 0.0 {
             return Err(ModelError::InvalidInput("every loss weight is 0".into()));
         }

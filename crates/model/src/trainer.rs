@@ -19,7 +19,7 @@ use crate::error::{ModelError, Result};
 use crate::garnet::GarNet;
 use crate::loss::{LossConfig, LossTerms};
 use crate::metrics_log::{MetricsLog, MetricsRow};
-use crate::mirror::MirrorMap;
+use crate::recipe::RecipeRecord;
 use crate::schedule::CosineSchedule;
 use crate::topology::{GarmentTopology, TopologyTensors};
 use crate::train::{adam, evaluate_batch, train_step, StepReport};
@@ -88,8 +88,8 @@ pub struct Trainer {
     loss: LossConfig,
     lr: f64,
     state: TrainState,
-    /// The template's mirror map, while training mirrors samples.
-    mirror: Option<MirrorMap>,
+    /// The recipe this run trains by, stored in its checkpoints.
+    recipe: Option<RecipeRecord>,
     /// The name of the validation set of this run (see [`Trainer::set_validation_set`]).
     validation_set: Option<String>,
     /// Whether each epoch also writes its own checkpoint (see [`epoch_checkpoint_name`]).
@@ -129,7 +129,8 @@ impl Trainer {
     }
 
     /// Resumes from a checkpoint: network, optimiser state (a fresh Adam when the checkpoint
-    /// has none), loss config and progress; `lr` overrides the stored learning rate when given.
+    /// has none), loss config, recipe and progress; `lr` overrides the stored learning rate
+    /// when given.
     pub fn resume(path: &Path, lr: Option<f64>, device: &Device) -> Result<Trainer> {
         let ck = load_checkpoint(path)?;
         let device = device.clone().autodiff();
@@ -140,7 +141,10 @@ impl Trainer {
         } else {
             crate::train::PAPER_LEARNING_RATE
         });
-        Trainer::with_parts(model, optim, ck.setup, ck.loss, ck.state, lr, device)
+        let mut trainer =
+            Trainer::with_parts(model, optim, ck.setup, ck.loss, ck.state, lr, device)?;
+        trainer.recipe = ck.recipe;
+        Ok(trainer)
     }
 
     fn with_parts(
@@ -164,7 +168,7 @@ impl Trainer {
         let topo_valid = topology.to_device(&device.clone().inner());
         setup.validate()?;
         let spec = setup.input_spec();
-        let mut trainer = Trainer {
+        Ok(Trainer {
             model,
             optim,
             setup,
@@ -175,15 +179,13 @@ impl Trainer {
             loss,
             lr,
             state,
-            mirror: None,
+            recipe: None,
             validation_set: None,
             keep_epochs: false,
             training_set: None,
             checkpoint_every: None,
             device,
-        };
-        trainer.set_mirror(trainer.state.mirror)?;
-        Ok(trainer)
+        })
     }
 
     /// The network (on the autodiff device).
@@ -201,22 +203,20 @@ impl Trainer {
         &self.state
     }
 
-    /// Records the command line of this training run in the checkpoints it writes.
-    pub fn set_command(&mut self, command: String) {
-        self.state.command = Some(command);
+    /// Records the recipe this run trains by in the checkpoints it writes.
+    pub fn set_recipe(&mut self, recipe: RecipeRecord) {
+        self.recipe = Some(recipe);
     }
 
-    /// Records the flags that chose this run's training drapes (`""`: every drape; see
-    /// [`TrainState::train_drapes`]) in the checkpoints it writes.
-    pub fn set_train_drapes(&mut self, flags: String) {
-        self.state.train_drapes = Some(flags);
+    /// The recipe this run trains by, when it was given one.
+    pub fn recipe(&self) -> Option<&RecipeRecord> {
+        self.recipe.as_ref()
     }
 
     /// Names this run's validation set (say `standard-x3-lbs:tshirt:240`). A best validation
     /// E_dist that the checkpoint says was measured on another set does not compare with
     /// this run's: it is cleared, so the next validated epoch writes `best.garnet`, and
-    /// returned. A best that a checkpoint carries without its set's name (written before
-    /// the name was stored) is kept. Every new best is stored with this name.
+    /// returned. Every new best is stored with this name.
     pub fn set_validation_set(&mut self, name: &str) -> Option<f32> {
         self.validation_set = Some(name.to_string());
         match &self.state.validation {
@@ -230,8 +230,8 @@ impl Trainer {
 
     /// When `keep` is set, every epoch of [`Trainer::run_epoch`] also writes its checkpoint
     /// (network, Adam state and progress, as `last.garnet`) to
-    /// `out_dir/`[`epoch_checkpoint_name`]: the snapshots that `garnet average` averages
-    /// and that a run can branch from (copy one to another folder's `last.garnet`).
+    /// `out_dir/`[`epoch_checkpoint_name`]: snapshots to compare epochs by, or to branch a
+    /// run from (copy one to another folder's `last.garnet`).
     pub fn set_keep_epochs(&mut self, keep: bool) {
         self.keep_epochs = keep;
     }
@@ -294,48 +294,6 @@ impl Trainer {
         Ok(())
     }
 
-    /// Trains the next steps with `loss` instead of the loss the run began with (to change
-    /// L_vertex's power or weight in a fine-tune, see [`LossConfig::vertex_power`]); stored
-    /// in the checkpoints, so a resumed run keeps it. Fails when `loss` is not valid.
-    pub fn set_loss_config(&mut self, loss: LossConfig) -> Result<()> {
-        loss.validate()?;
-        self.loss = loss;
-        Ok(())
-    }
-
-    /// Mirrors every other training sample left-right from the next step on (`true`), or
-    /// none (`false`); stored in the checkpoints, so a resumed run keeps it. Mirrored
-    /// samples double the drapes the network sees (see [`crate::mirror`]). Fails when the
-    /// template is not left-right symmetric.
-    pub fn set_mirror(&mut self, on: bool) -> Result<()> {
-        self.mirror = if on {
-            Some(MirrorMap::new(&self.setup.template)?)
-        } else {
-            None
-        };
-        self.state.mirror = on;
-        Ok(())
-    }
-
-    /// The template's mirror map while training mirrors samples.
-    pub fn mirror_map(&self) -> Option<&MirrorMap> {
-        self.mirror.as_ref()
-    }
-
-    /// The samples the next step trains on: `samples` themselves, or with mirroring on, the
-    /// mirror image of those at an odd position counted from the step number (each epoch
-    /// shuffles, so each drape is seen mirrored in about half the epochs).
-    pub fn augment(&self, samples: &[Sample]) -> Result<Vec<Sample>> {
-        samples
-            .iter()
-            .enumerate()
-            .map(|(j, s)| match &self.mirror {
-                Some(m) if (self.state.step + j as u64) % 2 == 1 => m.mirror_sample(s, &self.spec),
-                _ => Ok(s.clone()),
-            })
-            .collect()
-    }
-
     /// Follows `schedule` from the next epoch of [`Trainer::fit`] on (`None`: the rate stays
     /// as set). Keeps a stored schedule with the same plan (see
     /// [`CosineSchedule::same_plan`]), so resuming with the same command continues it.
@@ -366,13 +324,10 @@ impl Trainer {
         )
     }
 
-    /// One optimiser step on `samples` (which need targets; mirrored as
-    /// [`Trainer::augment`] says); returns the loss terms and the gradient norm.
+    /// One optimiser step on `samples` (which need targets); returns the loss terms and the
+    /// gradient norm.
     pub fn step(&mut self, samples: &[Sample]) -> Result<StepReport> {
-        let batch = match self.mirror {
-            Some(_) => self.train_batch(&self.augment(samples)?)?,
-            None => self.train_batch(samples)?,
-        };
+        let batch = self.train_batch(samples)?;
         let report = train_step(
             &mut self.model,
             &mut self.optim,
@@ -498,6 +453,7 @@ impl Trainer {
             &self.setup,
             &self.loss,
             &self.state,
+            self.recipe.as_ref(),
         )
     }
 
@@ -530,8 +486,6 @@ impl Trainer {
             path: out_dir.to_path_buf(),
             source: e,
         })?;
-        self.state.averaged_epochs.clear();
-        self.state.averaged_weights.clear();
         let earlier_sittings = self.state.partial.as_ref().map_or(0.0, |p| p.seconds);
         let trained = self.train_epoch(train, Some(out_dir))?;
         let (train_terms, train_samples) = (trained.mean_terms(), trained.samples);
@@ -577,7 +531,6 @@ impl Trainer {
             grad_norm,
             validation,
             is_best,
-            vertex_power: self.loss.vertex_power,
         };
         MetricsLog::new(out_dir.join(METRICS_LOG)).append(&row)?;
         Ok(EpochReport {

@@ -103,33 +103,21 @@ fn save_without_optimizer(path: &std::path::Path, model: &GarNet, setup: &ModelS
         setup,
         &LossConfig::new(),
         &TrainState::default(),
+        None,
     )
     .unwrap();
 }
 
-/// Rewrites the checkpoint at `path` as a file from before the later metadata existed:
-/// `drop_meta` keys left out of its metadata, `drop_config` out of its config and
-/// `drop_loss` out of its loss (the safetensors header is JSON after its 8-byte length).
-fn strip_checkpoint(
+/// The checkpoint at `path` with its safetensors header's metadata changed by `edit` (the
+/// header is JSON after its 8-byte length).
+fn edit_metadata(
     path: &std::path::Path,
-    drop_meta: &[&str],
-    drop_config: &[&str],
-    drop_loss: &[&str],
+    edit: impl FnOnce(&mut serde_json::Map<String, serde_json::Value>),
 ) {
     let bytes = std::fs::read(path).unwrap();
     let n = u64::from_le_bytes(bytes[..8].try_into().unwrap()) as usize;
     let mut header: serde_json::Value = serde_json::from_slice(&bytes[8..8 + n]).unwrap();
-    let meta = header["__metadata__"].as_object_mut().unwrap();
-    for key in drop_meta {
-        assert!(meta.remove(*key).is_some(), "{key}");
-    }
-    for (field, drop) in [("config", drop_config), ("loss", drop_loss)] {
-        let mut v: serde_json::Value = serde_json::from_str(meta[field].as_str().unwrap()).unwrap();
-        for key in drop {
-            assert!(v.as_object_mut().unwrap().remove(*key).is_some(), "{key}");
-        }
-        meta[field] = serde_json::Value::String(v.to_string());
-    }
+    edit(header["__metadata__"].as_object_mut().unwrap());
     let mut head = serde_json::to_vec(&header).unwrap();
     head.resize(head.len().div_ceil(8) * 8, b' ');
     let mut out = (head.len() as u64).to_le_bytes().to_vec();
@@ -138,42 +126,65 @@ fn strip_checkpoint(
     std::fs::write(path, out).unwrap();
 }
 
-/// Checkpoints written before a field existed load with what they were trained with:
-/// positions in metres (input unit 1, centre 0), loss in metres with squared distances, no
-/// extra inputs, no canonical frame, DQS bodies.
+/// A file whose weights were damaged (one flipped bit), or of an older format, is refused
+/// with an error naming it; the recipe a network was trained by comes back as it was saved.
 #[test]
-fn checkpoints_from_before_later_fields_load_as_they_were_trained() {
+fn damaged_or_old_checkpoints_are_refused_and_recipes_round_trip() {
     let device = Device::flex();
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("old.garnet");
+    let path = dir.path().join("net.garnet");
     let s = setup(Variant::Naive, 60).with_body_skinning("lbs").unwrap();
     let model = s.config.init(&device).unwrap();
-    save_without_optimizer(&path, &model, &s);
-    let fresh = load_checkpoint(&path).unwrap();
-    assert_eq!(fresh.setup.body_skinning, "lbs");
-    assert!(fresh.setup.canonical_frame);
-    strip_checkpoint(
+    let recipe = RecipeRecord {
+        recipe: Recipe::parse(
+            "format = 1\ngarment = \"tube\"\nvariant = \"naive\"\ndata = \"d\"\n\
+             [schedule]\nepochs = 2\n",
+        )
+        .unwrap(),
+        command: "garnet train --recipe r.toml".into(),
+    };
+    let state = TrainState::default();
+    save_checkpoint(
         &path,
-        &["body.skinning", "canonical_frame"],
-        &[
-            "input_scale",
-            "input_centre",
-            "rest_input",
-            "body_contact",
-            "extra_blocks",
-        ],
-        &["units_per_metre", "vertex_power"],
+        &model,
+        None,
+        &s,
+        &LossConfig::new(),
+        &state,
+        Some(&recipe),
+    )
+    .unwrap();
+    let back = load_checkpoint(&path).unwrap();
+    assert_eq!(back.recipe.as_ref(), Some(&recipe));
+    assert_eq!(back.setup.body_skinning, "lbs");
+
+    // One bit flipped in the middle of the weights.
+    let mut bytes = std::fs::read(&path).unwrap();
+    let mid = bytes.len() - 1000;
+    bytes[mid] ^= 0x10;
+    let damaged = dir.path().join("damaged.garnet");
+    std::fs::write(&damaged, &bytes).unwrap();
+    for err in [
+        load_checkpoint(&damaged).unwrap_err().to_string(),
+        Draper::load(&damaged, &device).unwrap_err().to_string(),
+    ] {
+        assert!(
+            err.contains("damaged.garnet") && err.contains("checksum"),
+            "{err}"
+        );
+    }
+
+    // The format before this one.
+    let old = dir.path().join("old.garnet");
+    std::fs::copy(&path, &old).unwrap();
+    edit_metadata(&old, |m| {
+        m.insert("format".into(), "garnet-model-1".into());
+    });
+    let err = load_checkpoint(&old).unwrap_err().to_string();
+    assert!(
+        err.contains("old.garnet") && err.contains("garnet-model-2"),
+        "{err}"
     );
-    let old = load_checkpoint(&path).unwrap();
-    assert_eq!(old.setup.body_skinning, "dqs");
-    assert!(!old.setup.canonical_frame);
-    let c = &old.setup.config;
-    assert_eq!((c.input_scale, c.input_centre.clone()), (1.0, vec![0.0; 3]));
-    assert!(!c.rest_input && !c.body_contact && c.extra_blocks == 0);
-    assert_eq!(old.loss.units_per_metre, 1.0);
-    assert_eq!(old.loss.vertex_power, 2.0);
-    // The parameters are the same; only their meaning changed.
-    assert_eq!(old.model(&device).unwrap().num_params(), model.num_params());
 }
 
 /// A closed ellipsoid body with faces (an icosphere, 642 vertices) and its topology.
@@ -529,7 +540,8 @@ fn corrupt_or_foreign_checkpoints_are_clear_errors() {
         None,
         &local,
         &LossConfig::new(),
-        &TrainState::default()
+        &TrainState::default(),
+        None,
     )
     .is_err());
 }
@@ -610,7 +622,7 @@ fn trainer_writes_checkpoints_and_metrics_and_resumes() {
     assert_eq!(text.lines().count(), 3);
     assert_eq!(trainer.state().step, 4);
     // The schedule sets each epoch's rate; every step reports its gradient norm, and the
-    // log its L_vertex power.
+    // log the epoch's mean.
     assert_eq!(reports[0].lr, 1e-3);
     assert!((reports[1].lr - schedule.lr(1)).abs() < 1e-15);
     assert!(reports.iter().all(|r| r.grad_norm > 0.0));
@@ -618,7 +630,7 @@ fn trainer_writes_checkpoints_and_metrics_and_resumes() {
         .lines()
         .nth(1)
         .unwrap()
-        .ends_with(&format!(",{},2", reports[0].grad_norm)));
+        .ends_with(&format!(",{}", reports[0].grad_norm)));
 
     // The resumed run keeps the clipping and the schedule (a new plan of the same rates
     // and end keeps the old start).
@@ -727,64 +739,7 @@ fn tiny_model_overfits_one_sample_below_one_millimetre() {
     assert!(e < 1e-3, "E_dist {e} m after {steps} steps");
 }
 
-/// With mirroring on, every other sample of the steps (counted from the step number) is
-/// replaced by its mirror image, and a resumed trainer keeps mirroring.
-#[test]
-fn mirroring_alternates_samples_and_survives_resume() {
-    let device = Device::flex();
-    let dir = tempfile::tempdir().unwrap();
-    let mut s = setup(Variant::Global, 60);
-    // Turn the tube so its open seam faces -z: then it is left-right symmetric.
-    let first_row = s.template.vertices.iter().filter(|p| p.y == 0.7).count();
-    let turn = std::f32::consts::FRAC_PI_2 + std::f32::consts::PI / first_row as f32;
-    let rotation = glam::Quat::from_rotation_y(-turn);
-    for p in &mut s.template.vertices {
-        *p = rotation * *p;
-    }
-    let data = samples(&s, 2);
-    let mut trainer = Trainer::new(s.clone(), LossConfig::new(), 1e-3, &device).unwrap();
-    assert!(trainer.mirror_map().is_none());
-    assert_eq!(bits_of(&trainer.augment(&data).unwrap()), bits_of(&data));
-    trainer.set_mirror(true).unwrap();
-    let map = trainer.mirror_map().unwrap().clone();
-    assert!(map.max_offset() < 1e-5, "{}", map.max_offset());
-    let spec = s.input_spec();
-    let mirrored: Vec<Sample> = data
-        .iter()
-        .map(|d| map.mirror_sample(d, &spec).unwrap())
-        .collect();
-    assert_ne!(bits_of(&mirrored), bits_of(&data));
-    // Step 0: the second sample is mirrored; step 1: the first.
-    let expect = |a: &Sample, b: &Sample| bits_of(&[a.clone(), b.clone()]);
-    assert_eq!(
-        bits_of(&trainer.augment(&data).unwrap()),
-        expect(&data[0], &mirrored[1])
-    );
-    trainer.step(&data[..1]).unwrap();
-    assert_eq!(
-        bits_of(&trainer.augment(&data).unwrap()),
-        expect(&mirrored[0], &data[1])
-    );
-    let path = dir.path().join("last.garnet");
-    trainer.save(&path).unwrap();
-    let resumed = Trainer::resume(&path, None, &device).unwrap();
-    assert!(resumed.state().mirror && resumed.mirror_map() == Some(&map));
-    assert_eq!(
-        bits_of(&resumed.augment(&data).unwrap()),
-        expect(&mirrored[0], &data[1])
-    );
-}
-
-/// The coordinates of every sample's body, M and G as bits.
-fn bits_of(samples: &[Sample]) -> Vec<u32> {
-    let lists: Vec<Vec<Vec3>> = samples
-        .iter()
-        .flat_map(|s| [s.body.clone(), s.warped.clone(), s.target.clone().unwrap()])
-        .collect();
-    bits(&lists)
-}
-
-/// Regression (session 23): a run resumed on another dataset kept the best validation
+/// Regression: a run resumed on another dataset kept the best validation
 /// E_dist of the old one, so it never wrote `best.garnet`. A checkpoint now names the set
 /// its best was measured on, and a run validating on another set starts its best afresh.
 #[test]
@@ -819,7 +774,16 @@ fn best_starts_afresh_on_another_validation_set() {
     let mut state = carried.state.clone();
     state.best_e_dist_cm = Some(1e-6);
     let model = carried.model(&device).unwrap();
-    save_checkpoint(&last, &model, None, &carried.setup, &carried.loss, &state).unwrap();
+    save_checkpoint(
+        &last,
+        &model,
+        None,
+        &carried.setup,
+        &carried.loss,
+        &state,
+        None,
+    )
+    .unwrap();
     std::fs::remove_file(&best).unwrap();
     let mut resumed = Trainer::resume(&last, None, &device).unwrap();
     assert_eq!(resumed.set_validation_set("set-b:tube"), Some(1e-6));
@@ -942,28 +906,6 @@ fn an_epoch_stopped_inside_resumes_where_it_stopped() {
         checkpoint_params(&same_trainer.path().join("last.garnet"), &device),
         checkpoint_params(&whole_last, &device)
     );
-    // A network made from it (an average, a grown one) begins its next epoch afresh.
-    let made = dir.path().join("made");
-    std::fs::create_dir(&made).unwrap();
-    let mean = made.join("mean.garnet");
-    average_checkpoints(
-        &[&mid, &mid],
-        None,
-        &mean,
-        "garnet average",
-        recorded_drapes,
-    )
-    .unwrap();
-    let grown = made.join("grown.garnet");
-    let plan = GrowPlan {
-        extra_blocks: 1,
-        ..GrowPlan::default()
-    };
-    grow_checkpoint(&mid, &grown, &plan, "garnet grow").unwrap();
-    for path in [&mean, &grown] {
-        assert_eq!(load_checkpoint(path).unwrap().state.partial, None);
-    }
-
     let mut elsewhere = Trainer::resume(&mid, None, &device).unwrap();
     elsewhere.set_training_set("set-b");
     let refused = elsewhere
@@ -1048,218 +990,19 @@ fn global_trainer_on_two_samples(device: &Device) -> (Trainer, Vec<Sample>) {
     )
 }
 
-/// The training drapes a checkpoint's progress records, as `garnet average` is told to read
-/// them.
-fn recorded_drapes(state: &TrainState) -> Option<String> {
-    state.train_drapes.clone()
-}
+/// Collects the values of every float parameter of a module, in visiting order.
+struct ParamValues(Vec<Vec<f32>>);
 
-/// The parameter values of the network in the checkpoint at `path`.
-fn checkpoint_params(path: &std::path::Path, device: &Device) -> Vec<model::average::ParamValues> {
-    model::average::parameter_values(&load_checkpoint(path).unwrap().model(device).unwrap())
-        .unwrap()
-}
-
-/// `average_checkpoints` writes the mean network with the last input's progress, the
-/// averaged epochs and no best figure; checkpoints of other setups are refused.
-#[test]
-fn averaged_checkpoint_holds_the_mean_network() {
-    let device = Device::flex();
-    let dir = tempfile::tempdir().unwrap();
-    let (mut trainer, data) = global_trainer_on_two_samples(&device);
-    let train = || vec![Ok::<_, String>(data.clone())];
-    trainer.set_command("garnet train x".into());
-    trainer.set_train_drapes(" --at-rest".into());
-    trainer.set_keep_epochs(true);
-    trainer
-        .fit(3, |_, _| train(), NO_VALIDATION, dir.path(), |_| {})
-        .unwrap();
-    let snapshots: Vec<_> = (1..=3)
-        .map(|e| dir.path().join(epoch_checkpoint_name(e)))
-        .collect();
-    let inputs: Vec<&std::path::Path> = snapshots.iter().map(|p| p.as_path()).collect();
-    let out = dir.path().join("mean.garnet");
-    let report =
-        average_checkpoints(&inputs, None, &out, "garnet average", recorded_drapes).unwrap();
-    assert_eq!(report.epochs, vec![1, 2, 3]);
-    let mean = load_checkpoint(&out).unwrap();
-    assert!(!mean.has_optimizer());
-    assert_eq!(mean.state.epoch, 3);
-    assert_eq!(mean.state.averaged_epochs, vec![1, 2, 3]);
-    assert_eq!(mean.state.best_e_dist_cm, None);
-    assert!(mean
-        .state
-        .command
-        .as_deref()
-        .unwrap()
-        .ends_with("; then garnet average"));
-    // Inputs that trained on the same drapes pass them on; inputs that disagree leave them
-    // unrecorded.
-    assert_eq!(mean.state.train_drapes.as_deref(), Some(" --at-rest"));
-    let by_epoch = |s: &TrainState| Some(format!("epoch {}", s.epoch.min(2)));
-    let partly = dir.path().join("partly.garnet");
-    average_checkpoints(&inputs[..2], None, &partly, "x", by_epoch).unwrap();
-    assert_eq!(load_checkpoint(&partly).unwrap().state.train_drapes, None);
-    average_checkpoints(&inputs[1..], None, &partly, "x", by_epoch).unwrap();
-    assert_eq!(
-        load_checkpoint(&partly)
-            .unwrap()
-            .state
-            .train_drapes
-            .as_deref(),
-        Some("epoch 2")
-    );
-    let nets: Vec<GarNet> = inputs
-        .iter()
-        .map(|p| load_checkpoint(p).unwrap().model(&device).unwrap())
-        .collect();
-    let expected = model::average::parameter_values(&average_networks(&nets).unwrap()).unwrap();
-    let got = checkpoint_params(&out, &device);
-    assert_eq!(got, expected);
-    assert_ne!(got, model::average::parameter_values(&nets[2]).unwrap());
-
-    // Weights give the weighted combination; weights that do not sum to 1 are refused.
-    let weights = [0.25, -0.25, 1.0];
-    average_checkpoints(
-        &inputs,
-        Some(&weights),
-        &out,
-        "garnet average",
-        recorded_drapes,
-    )
-    .unwrap();
-    let expected = combine_networks(&nets, &weights).unwrap();
-    assert_eq!(
-        checkpoint_params(&out, &device),
-        model::average::parameter_values(&expected).unwrap()
-    );
-    let err = average_checkpoints(&inputs, Some(&[0.5, 0.5, 0.5]), &out, "x", recorded_drapes)
-        .unwrap_err()
-        .to_string();
-    assert!(err.contains("sum to"), "{err}");
-
-    // One input, or inputs of another garment template, are refused.
-    assert!(average_checkpoints(&inputs[..1], None, &out, "x", recorded_drapes).is_err());
-    let other = dir.path().join("other.garnet");
-    let s2 = setup(Variant::Global, 90);
-    let t2 = Trainer::new(s2, LossConfig::new(), 1e-3, &device).unwrap();
-    t2.save(&other).unwrap();
-    let err = average_checkpoints(&[inputs[0], &other], None, &out, "x", recorded_drapes)
-        .unwrap_err()
-        .to_string();
-    assert!(err.contains("not averageable"), "{err}");
-}
-
-/// A GarNet-Local checkpoint `dir/parent.garnet` after two training steps on the first two
-/// of three synthetic samples, and the samples.
-fn trained_parent(dir: &std::path::Path, device: &Device) -> (std::path::PathBuf, Vec<Sample>) {
-    let s = setup(Variant::Local, 60);
-    let data = samples(&s, 3);
-    let mut trainer = Trainer::new(s, LossConfig::new(), 1e-3, device).unwrap();
-    for _ in 0..2 {
-        trainer.step(&data[..2]).unwrap();
+impl burn::module::ModuleVisitor for ParamValues {
+    fn visit_float<const D: usize>(&mut self, param: &burn::module::Param<Tensor<D>>) {
+        self.0.push(model::tensors::read_f32(param.val()).unwrap());
     }
-    let parent = dir.join("parent.garnet");
-    trainer.save(&parent).unwrap();
-    (parent, data)
 }
 
-/// A checkpoint grown by `grow_checkpoint` drapes bit for bit as its parent, keeps its
-/// progress, and its new blocks learn: after training steps their head weights are no
-/// longer zero and the drapes differ.
-#[test]
-fn grown_checkpoint_drapes_as_its_parent_then_trains_its_new_blocks() {
-    let device = Device::flex();
-    let dir = tempfile::tempdir().unwrap();
-    let (parent, data) = trained_parent(dir.path(), &device);
-    let grown = dir.path().join("grown.garnet");
-    let plan = GrowPlan {
-        extra_blocks: 2,
-        ..GrowPlan::default()
-    };
-    let params = grow_checkpoint(&parent, &grown, &plan, "garnet grow").unwrap();
-    let ck = load_checkpoint(&grown).unwrap();
-    assert_eq!(ck.setup.config.extra_blocks, 2);
-    assert_eq!(ck.state.step, 2);
-    assert!(!ck.has_optimizer());
-    assert!(ck.setup.config.method_name().ends_with(" +2 blocks"));
-    assert_eq!(ck.model(&device).unwrap().num_params(), params);
-
-    let pairs: Vec<(&[Vec3], &[Vec3])> =
-        data.iter().map(|d| (&d.body[..], &d.warped[..])).collect();
-    let before = Draper::load(&parent, &device)
-        .unwrap()
-        .drape_batch(&pairs)
-        .unwrap();
-    let after = Draper::load(&grown, &device)
-        .unwrap()
-        .drape_batch(&pairs)
-        .unwrap();
-    assert_eq!(bits(&before), bits(&after));
-
-    let mut more = Trainer::resume(&grown, None, &device).unwrap();
-    for _ in 0..2 {
-        more.step(&data[..2]).unwrap();
-    }
-    let w = model::tensors::read_f32(more.model().garment.extra[1].conv.w.weight.val()).unwrap();
-    assert!(w.iter().any(|&v| v != 0.0));
-    let trained = more.draper().unwrap().drape_batch(&pairs).unwrap();
-    assert_ne!(bits(&trained), bits(&after));
-    assert!(grow_checkpoint(&parent, &grown, &GrowPlan::default(), "x").is_err());
-}
-
-/// A checkpoint widened by `grow_checkpoint` (wider convolutions and fusion, then an extra
-/// block) drapes as its parent up to the rounding of longer sums, and training reaches its
-/// new features: the weights from them into trained ones start at zero and leave it.
-#[test]
-fn widened_checkpoint_drapes_as_its_parent_then_trains_its_new_features() {
-    let device = Device::flex();
-    let dir = tempfile::tempdir().unwrap();
-    let (parent, data) = trained_parent(dir.path(), &device);
-    let wide = dir.path().join("wide.garnet");
-    let plan = GrowPlan {
-        extra_blocks: 1,
-        conv_width: Some(24),
-        fusion: Some(vec![80, 48, 16]),
-    };
-    let params = grow_checkpoint(&parent, &wide, &plan, "garnet grow").unwrap();
-    let ck = load_checkpoint(&wide).unwrap();
-    let cfg = &ck.setup.config;
-    assert_eq!((cfg.conv_width, cfg.extra_blocks), (24, 1));
-    assert_eq!(cfg.fusion, vec![80, 48, 16]);
-    assert_eq!(ck.state.step, 2);
-    assert_eq!(ck.model(&device).unwrap().num_params(), params);
-
-    let pairs: Vec<(&[Vec3], &[Vec3])> =
-        data.iter().map(|d| (&d.body[..], &d.warped[..])).collect();
-    let drape = |p: &std::path::Path| {
-        let d = Draper::load(p, &device)
-            .unwrap()
-            .drape_batch(&pairs)
-            .unwrap();
-        d.into_iter().flatten().collect::<Vec<Vec3>>()
-    };
-    let (before, after) = (drape(&parent), drape(&wide));
-    let worst = before
-        .iter()
-        .zip(&after)
-        .map(|(a, b)| a.distance(*b))
-        .fold(0.0f32, f32::max);
-    assert!(worst < 1e-5, "widening moved a vertex {worst} m");
-
-    // The second fusion layer's rows from the new first-layer features, into its trained
-    // columns (the first 32), are zero, and training moves them.
-    let new_rows = |t: &Trainer| {
-        let w = model::tensors::read_f32(t.model().fusion.hidden[0].weight.val()).unwrap();
-        (64..80)
-            .flat_map(|r| (0..32).map(move |c| (r, c)))
-            .map(|(r, c)| w[r * 48 + c])
-            .collect::<Vec<f32>>()
-    };
-    let mut more = Trainer::resume(&wide, None, &device).unwrap();
-    assert!(new_rows(&more).iter().all(|&v| v == 0.0));
-    for _ in 0..2 {
-        more.step(&data[..2]).unwrap();
-    }
-    assert!(new_rows(&more).iter().any(|&v| v != 0.0));
+/// The values of the network parameters of the checkpoint at `path`.
+fn checkpoint_params(path: &std::path::Path, device: &Device) -> Vec<Vec<f32>> {
+    let model = load_checkpoint(path).unwrap().model(device).unwrap();
+    let mut values = ParamValues(Vec::new());
+    model.visit(&mut values);
+    values.0
 }
