@@ -862,3 +862,22 @@ fn drape_gives_the_vertices_it_gave_before() {
         assert!(worst < 1e-5, "{name}: a vertex moved {worst} m");
     }
 }
+
+/// `garnet train` takes a recipe and a handful of overrides: at most ten options.
+#[test]
+fn train_takes_a_recipe_and_few_options() {
+    let help = ok(&["train", "--help"]);
+    let options = help
+        .lines()
+        .filter(|l| l.starts_with("  -") || l.starts_with("      --"))
+        .count();
+    assert!(options <= 10, "{options} options:\n{help}");
+    assert!(help.contains("--recipe"), "{help}");
+    // Every shipped recipe parses and names its garment and variant in its file name.
+    for entry in std::fs::read_dir(common::repo().join("recipes")).unwrap() {
+        let path = entry.unwrap().path();
+        let recipe = model::Recipe::load(&path).unwrap();
+        let name = format!("{}-{}.toml", recipe.garment, recipe.variant);
+        assert_eq!(path.file_name().unwrap().to_str().unwrap(), name);
+    }
+}

@@ -9,7 +9,7 @@
 //! the activation, a concatenation and the max pooling each passed over it again: the
 //! fusion MLP took about 21 ms at 10k garment vertices where its products take 7-14 ms,
 //! and the garment stream's global layer 15 ms where its product takes 3-5 ms
-//! (docs/model.md "Speed", session 44).
+//! (docs/findings.md, "Speed").
 
 use burn::nn::Linear;
 use burn::prelude::*;

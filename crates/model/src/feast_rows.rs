@@ -8,7 +8,7 @@
 //! every step was a tensor of its own, allocated zeroed and copied once more for alignment:
 //! the concatenation, the `[N,K,M]` assignment (gathers, products, sums, a division) and a
 //! 16 MB `[N,d_in*M]` aggregate for a 10k-vertex garment, written and read again by the
-//! product (`perf`, docs/model.md "Speed", session 43).
+//! product (`perf`; docs/findings.md, "Speed").
 
 use std::mem::MaybeUninit;
 

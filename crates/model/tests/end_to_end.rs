@@ -871,7 +871,7 @@ fn an_epoch_stopped_inside_resumes_where_it_stopped() {
                 0 => batches(skip),
                 _ => {
                     let mut b = batches(skip);
-                    b.insert(2, Err("the session ended".into()));
+                    b.insert(2, Err("the data source stopped".into()));
                     b
                 }
             },
@@ -880,7 +880,7 @@ fn an_epoch_stopped_inside_resumes_where_it_stopped() {
             |_| {},
         )
         .unwrap_err();
-    assert!(err.to_string().contains("the session ended"));
+    assert!(err.to_string().contains("the data source stopped"));
     let mid = dir.path().join(model::trainer::MID_EPOCH_CHECKPOINT);
     assert_eq!(
         Trainer::resume_point(dir.path()).unwrap(),
