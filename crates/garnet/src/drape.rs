@@ -117,6 +117,9 @@ pub struct DrapedGarment {
     pub kind: String,
     /// The draped mesh: `[N]` vertices (metres, the body's frame) and the template's faces.
     pub mesh: TriMesh,
+    /// The network's input M: the template warped onto the posed body by DQS, `[N]`
+    /// vertices (metres).
+    pub warped: Vec<glam::Vec3>,
     /// What the time went to, ms.
     pub timings: DrapeTimings,
     /// How many vertices the push-out moved (0 without it).
@@ -181,13 +184,13 @@ pub fn drape(
                     network_ms: start.elapsed().as_secs_f64() * 1e3,
                     push_out_ms: 0.0,
                 };
-                Ok((draped, timings))
+                Ok((draped, warped.vertices, timings))
             })
             .collect::<anyhow::Result<Vec<_>>>()
     });
     let collider = collider?;
     let mut garments = Vec::with_capacity(models.len());
-    for (m, (mut vertices, mut timings)) in models.iter().zip(predicted?) {
+    for (m, (mut vertices, warped, mut timings)) in models.iter().zip(predicted?) {
         let start = Instant::now();
         let pushed_out = collider.as_ref().map_or(0, |(c, _)| {
             c.push_out(&mut vertices, PUSH_OUT_WITHIN, push_out_gap())
@@ -199,6 +202,7 @@ pub fn drape(
                 vertices,
                 faces: m.template.mesh.faces.clone(),
             },
+            warped,
             timings,
             pushed_out,
         });

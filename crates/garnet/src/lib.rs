@@ -29,11 +29,13 @@ pub mod drape;
 pub mod drapes;
 pub mod eval;
 pub mod export;
+pub mod motion;
 pub mod shipped;
 
 pub use burn::prelude::Device;
 pub use drape::{drape, Drape, DrapeOptions, DrapeTimings, DrapedGarment, GarmentModel};
 pub use eval::{evaluate, EvalOptions, EvalReport};
+pub use motion::{drape_motion, FrameRange, Motion, MotionOptions};
 pub use shipped::{shipped_models, shipped_models_dir, SHIPPED_MODELS};
 
 pub use body;

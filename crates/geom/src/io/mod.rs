@@ -1,8 +1,10 @@
-//! Mesh file I/O (OBJ, PLY, GLB) and the atomic-write helper every crate uses.
+//! Mesh file I/O (OBJ, PLY, GLB), animations (animated GLB, PC2 point caches) and the
+//! atomic-write helper every crate uses.
 //!
 //! Readers never panic on bad input: errors name the file and the line (text) or byte offset
 //! (binary). Writers validate the mesh first and write through [`write_atomic`].
 
+mod anim;
 mod atomic;
 mod glb;
 mod glb_read;
@@ -12,6 +14,10 @@ mod ply;
 
 use std::path::Path;
 
+pub use anim::{
+    encode_animated_glb, encode_pc2, parse_pc2, read_pc2, write_animated_glb, write_pc2,
+    AnimatedMesh, PointCache,
+};
 pub use atomic::{write_atomic, write_bytes_atomic};
 pub use glb::{encode_glb, write_glb, GlbMesh, DEFAULT_COLOR};
 pub use glb_read::{parse_glb, read_glb, read_glb_merged, GlbPrimitive};
