@@ -8,6 +8,7 @@ use std::path::Path;
 use dataset::{LoadedSpec, Manifest, Plan};
 
 const SPEC: &str = r#"
+format = 2
 seed = 17
 shard_size = 8
 [bodies]
