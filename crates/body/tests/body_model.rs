@@ -296,8 +296,8 @@ fn clearance_leaves_the_rest_pose_alone_and_lifts_an_arm_out_of_the_chest() {
     assert!(cleared.rotations[right].angle_between(sunk.rotations[right]) < 1e-5);
 }
 
-/// The clearance measures the body skinned as its options say (it always used DQS before
-/// session 16, whatever the drape's skinning): its counts are those of that body.
+/// The clearance measures the body skinned as its options say, whatever the drape's
+/// skinning: its counts are those of that body.
 #[test]
 fn clearance_measures_the_body_as_it_is_skinned() {
     use body::clearance::{buried_vertices, clear_limbs, ClearanceOptions, PROBE};
