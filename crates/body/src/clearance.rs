@@ -64,8 +64,8 @@ pub struct ClearanceOptions {
     /// How the body is skinned for the test. Dual quaternion skinning by default, also for
     /// drapes on linearly blended bodies: linear blending collapses the armpit, so measured
     /// on it the arms turn further from the asked pose (up to 21 degrees where DQS turned 9),
-    /// and the cloth did not gain from it. Session 16, 2 cm T-shirts on LBS bodies, 16
-    /// random shapes in procedural poses each: "any" poses 12 of 16 at rest under 2% strain
+    /// and the cloth did not gain from it. 2 cm T-shirts on LBS bodies, 16 random shapes in
+    /// procedural poses each: "any" poses 12 of 16 at rest under 2% strain
     /// p99 when measured on LBS against 14 measured on DQS, yoga poses 15 and 15.
     pub skinning: Skinning,
 }

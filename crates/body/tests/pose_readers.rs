@@ -1,10 +1,11 @@
-//! Pose readers on the real CMU clips (skipped when the shared mocap folder is absent)
-//! and on the hand-made malformed fixtures.
+//! Pose readers on clips garnet writes itself (a CMU-style skeleton walking, see
+//! `body::pose::synthetic_clip`) and on the hand-made malformed fixtures.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use body::pose::synthetic::a_pose_rig;
+use body::pose::synthetic_clip::{cmu_asf_text, walk_amc_text, write_cmu_clip, WALK_SPEED};
 use body::pose::{
     bvh_string, save_bvh, Amc, Asf, Bvh, BvhWriteOptions, Clip, PoseError, RetargetOptions,
 };
@@ -14,15 +15,16 @@ fn crate_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// The CMU subject 02 folder, or `None` (with a message) when it is absent.
-fn cmu02() -> Option<PathBuf> {
-    let dir = crate_dir().join("../../../shared/mocap/cmu/02");
-    if dir.join("02.asf").is_file() && dir.join("02_01.amc").is_file() {
-        Some(dir)
-    } else {
-        println!("skipped: {} not found", dir.display());
-        None
-    }
+/// Frames of the walk clip: 2 s at 120 Hz.
+const FRAMES: usize = 240;
+
+/// A folder holding the walk `cmu/02/02_01.amc` and its skeleton `cmu/02/02.asf`; returns
+/// the folder (kept alive by the guard) and the skeleton and clip paths.
+fn walk() -> (tempfile::TempDir, PathBuf, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let amc = write_cmu_clip(dir.path(), "cmu/02/02_01.amc", FRAMES).unwrap();
+    let asf = dir.path().join("cmu/02/02.asf");
+    (dir, asf, amc)
 }
 
 fn fixture(name: &str) -> PathBuf {
@@ -30,45 +32,54 @@ fn fixture(name: &str) -> PathBuf {
 }
 
 #[test]
-fn cmu_walk_parses() {
-    let Some(dir) = cmu02() else { return };
-    let asf = Asf::read(dir.join("02.asf")).unwrap();
+fn cmu_style_walk_parses() {
+    let (_dir, asf_path, amc_path) = walk();
+    let asf = Asf::read(&asf_path).unwrap();
     assert_eq!(asf.bones.len(), 30);
+    assert_eq!(asf.order().len(), 30);
     let femur = &asf.bones[asf.bone_index("lfemur").unwrap()];
-    assert!((femur.length * asf.metres_per_unit() - 0.4286).abs() < 1e-3);
-    let t = Instant::now();
-    let amc = Amc::read(dir.join("02_01.amc"), &asf).unwrap();
-    println!(
-        "02_01.amc: {} frames read in {:?}",
-        amc.frame_count(),
-        t.elapsed()
-    );
-    assert_eq!(amc.frame_count(), 343);
-    assert_eq!(amc.frame_numbers[342], 343);
+    assert!((femur.length * asf.metres_per_unit() - 0.4289).abs() < 1e-3);
+    let tibia = asf.bone_index("ltibia").unwrap();
+    assert_eq!(asf.bones[tibia].parent, asf.bone_index("lfemur"));
+    assert_eq!(asf.bones[asf.bone_index("lhipjoint").unwrap()].parent, None);
+    let amc = Amc::read(&amc_path, &asf).unwrap();
+    assert_eq!(amc.frame_count(), FRAMES);
+    assert_eq!(amc.frame_numbers[FRAMES - 1], FRAMES as i64);
+    assert!(amc.fits(&asf));
+    // Values read back as written: the root's forward translation (file units) and the
+    // left hip's flexion (degrees in the file, radians once read).
+    let text = walk_amc_text(FRAMES, 1);
+    let lines: Vec<&str> = text.lines().collect();
+    let root: Vec<f64> = lines[4]
+        .split_whitespace()
+        .skip(1)
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert!(amc
+        .root(0)
+        .iter()
+        .zip(&root)
+        .all(|(a, b)| (a - b).abs() < 1e-9));
+    let femur_line = lines.iter().find(|l| l.starts_with("lfemur ")).unwrap();
+    let rx: f64 = femur_line
+        .split_whitespace()
+        .nth(1)
+        .unwrap()
+        .parse()
+        .unwrap();
+    let lfemur = asf.bone_index("lfemur").unwrap();
+    assert!((amc.bone(0, lfemur)[0] - rx.to_radians()).abs() < 1e-9);
 }
 
 #[test]
 fn long_amc_reads_fast() {
-    let Some(dir) = cmu02() else { return };
-    let asf = Asf::read(dir.join("02.asf")).unwrap();
-    let text = std::fs::read_to_string(dir.join("02_01.amc")).unwrap();
-    // The 29 bone lines of the first frame (the line after the frame number "1").
-    let lines: Vec<&str> = text.lines().collect();
-    let first = lines.iter().position(|l| l.trim() == "1").unwrap();
-    let body: String = lines[first + 1..first + 30]
-        .iter()
-        .map(|l| format!("{l}\n"))
-        .collect();
-    let mut long = String::from(":FULLY-SPECIFIED\n:DEGREES\n");
-    for f in 1..=4000 {
-        long.push_str(&format!("{f}\n{body}"));
-    }
+    let asf = Asf::parse(&cmu_asf_text(), Path::new("cmu.asf")).unwrap();
+    let long = walk_amc_text(4000, 0);
     let t = Instant::now();
     let amc = Amc::parse(&long, Path::new("long.amc"), &asf).unwrap();
     let took = t.elapsed();
-    println!("4000-frame AMC parsed in {took:?}");
     assert_eq!(amc.frame_count(), 4000);
-    assert!(took.as_secs_f64() < 2.0);
+    assert!(took.as_secs_f64() < 2.0, "4000 frames parsed in {took:?}");
 }
 
 /// Posed head/tail of a rig bone.
@@ -78,21 +89,15 @@ fn at(rig: &Rig, pose: &Pose, name: &str) -> (glam::Vec3, glam::Vec3) {
 
 #[test]
 fn retargeted_walk_stands_upright() {
-    let Some(dir) = cmu02() else { return };
-    let clip = Clip::from_asf_amc(dir.join("02.asf"), dir.join("02_01.amc")).unwrap();
-    assert_eq!(clip.frame_count(), 343);
+    let (_dir, asf, amc) = walk();
+    let clip = Clip::from_asf_amc(&asf, &amc).unwrap();
+    assert_eq!(clip.frame_count(), FRAMES);
     assert_eq!(clip.frame_rate(), 120.0);
     let rig = a_pose_rig();
     let opts = RetargetOptions::default();
-    let t = Instant::now();
-    let pose = clip.pose(0, &rig, &opts).unwrap();
-    println!("one frame retargeted in {:?}", t.elapsed());
-    for f in [0, 85, 170, 255, 342] {
-        let pose = if f == 0 {
-            pose.clone()
-        } else {
-            clip.pose(f, &rig, &opts).unwrap()
-        };
+    let last = FRAMES - 1;
+    for f in [0, 60, 120, 180, last] {
+        let pose = clip.pose(f, &rig, &opts).unwrap();
         let head = at(&rig, &pose, "Head").1;
         let hips = at(&rig, &pose, "Hips").0;
         assert!(pose.root_translation.x == 0.0 && pose.root_translation.z == 0.0);
@@ -125,23 +130,24 @@ fn retargeted_walk_stands_upright() {
         keep_horizontal_translation: true,
     };
     let a = clip.pose(0, &rig, &keep).unwrap().root_translation;
-    let b = clip.pose(342, &rig, &keep).unwrap().root_translation;
-    assert!(b.z - a.z > 1.0, "the walk moves forward (+Z): {a} -> {b}");
+    let b = clip.pose(last, &rig, &keep).unwrap().root_translation;
+    let walked = WALK_SPEED as f32 * last as f32 / 120.0;
+    assert!(
+        b.z - a.z > 0.5 * walked,
+        "the walk moves forward (+Z): {a} -> {b}"
+    );
     assert!(matches!(
-        clip.pose(343, &rig, &opts),
-        Err(PoseError::FrameOutOfRange {
-            frame: 343,
-            count: 343
-        })
+        clip.pose(FRAMES, &rig, &opts),
+        Err(PoseError::FrameOutOfRange { frame, count }) if frame == FRAMES && count == FRAMES
     ));
 }
 
 #[test]
 fn bvh_written_from_the_walk_reads_back() {
-    let Some(dir) = cmu02() else { return };
-    let asf = Asf::read(dir.join("02.asf")).unwrap();
-    let amc = Amc::read(dir.join("02_01.amc"), &asf).unwrap();
-    let path = std::env::temp_dir().join(format!("garnet_pose_{}_02_01.bvh", std::process::id()));
+    let (dir, asf_path, amc_path) = walk();
+    let asf = Asf::read(&asf_path).unwrap();
+    let amc = Amc::read(&amc_path, &asf).unwrap();
+    let path = dir.path().join("02_01.bvh");
     save_bvh(&path, &asf, &amc, &BvhWriteOptions::default()).unwrap();
     let bvh = Bvh::read(&path, None).unwrap();
     assert!(
@@ -149,7 +155,7 @@ fn bvh_written_from_the_walk_reads_back() {
         "unit detected"
     );
     assert_eq!(bvh.joints.len(), 31);
-    assert_eq!(bvh.frame_count(), 343);
+    assert_eq!(bvh.frame_count(), FRAMES);
     let height = 1.7;
     let mut worst: f64 = 0.0;
     for f in 0..amc.frame_count() {
@@ -165,12 +171,11 @@ fn bvh_written_from_the_walk_reads_back() {
         let tips = bvh.end_sites(&world, &pos);
         assert_eq!(tips.len(), 7);
     }
-    println!("BVH round trip: worst joint error {worst:e} m");
-    assert!(worst < 1e-4 * height);
+    assert!(worst < 1e-4 * height, "worst joint error {worst:e} m");
     // The BVH clip retargets like the ASF/AMC clip.
     let rig = a_pose_rig();
     let from_bvh = Clip::from_bvh(&path, None).unwrap();
-    let from_amc = Clip::from_asf_amc(dir.join("02.asf"), dir.join("02_01.amc")).unwrap();
+    let from_amc = Clip::from_asf_amc(&asf_path, &amc_path).unwrap();
     assert!((from_bvh.frame_rate() - 120.0).abs() < 1e-3);
     for f in [0, 200] {
         let a = rig.posed_joints(&from_amc.pose(f, &rig, &RetargetOptions::default()).unwrap());
@@ -182,7 +187,6 @@ fn bvh_written_from_the_walk_reads_back() {
             );
         }
     }
-    std::fs::remove_file(&path).ok();
     // Writing is deterministic.
     assert_eq!(
         bvh_string(&asf, &amc, &BvhWriteOptions::default()).unwrap(),

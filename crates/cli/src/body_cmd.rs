@@ -31,12 +31,13 @@ pub struct BodyArgs {
     /// Also write a picture (front and side views).
     #[arg(long, value_name = "FILE.png")]
     pub png: Option<PathBuf>,
-    /// Instead: a sheet of five random shapes in five poses each (needs --mocap).
+    /// Instead: a sheet of five random shapes in five poses each (needs the CMU clips).
     #[arg(long, value_name = "FILE.png")]
     pub sheet: Option<PathBuf>,
-    /// Folder of the CMU clips for --sheet (with 01/ and 02/ inside).
-    #[arg(long, value_name = "DIR", default_value = "../shared/mocap/cmu")]
-    pub mocap: PathBuf,
+    /// Folder of the CMU clips for --sheet, with 01/ and 02/ inside (default:
+    /// $GARNET_MOCAP/cmu).
+    #[arg(long, value_name = "DIR")]
+    pub mocap: Option<PathBuf>,
 }
 
 /// Skinning method on the command line.
@@ -58,7 +59,8 @@ impl From<SkinningArg> for Skinning {
 pub fn run(args: &BodyArgs) -> anyhow::Result<()> {
     let model = BodyModel::load()?;
     if let Some(sheet) = &args.sheet {
-        return write_sheet(&model, sheet, &args.mocap, args.skinning.into());
+        let mocap = crate::pose_args::cmu_folder(args.mocap.as_deref(), "body --sheet")?;
+        return write_sheet(&model, sheet, &mocap, args.skinning.into());
     }
     let phenotype = args.shape.phenotype(&model)?;
     let body = model.shape(&phenotype)?;

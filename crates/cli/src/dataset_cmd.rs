@@ -28,27 +28,48 @@ pub enum DatasetCmd {
 /// Where the mocap clips are.
 #[derive(Args, Debug)]
 pub struct MocapArg {
-    /// Folder that the spec's clip paths are relative to (default: $GARNET_MOCAP, else
-    /// ../shared/mocap relative to the working directory).
+    /// Folder that the spec's clip paths are relative to (default: $GARNET_MOCAP); needed
+    /// when the spec names clips.
     #[arg(long, value_name = "DIR")]
     pub mocap: Option<PathBuf>,
 }
 
 impl MocapArg {
-    /// `--mocap`, else `GARNET_MOCAP`, else `../shared/mocap`.
-    pub fn root(&self) -> PathBuf {
+    /// `--mocap`, else `GARNET_MOCAP`, else none.
+    pub fn root(&self) -> Option<PathBuf> {
         self.mocap
             .clone()
             .or_else(|| std::env::var_os("GARNET_MOCAP").map(PathBuf::from))
-            .unwrap_or_else(|| PathBuf::from("../shared/mocap"))
+    }
+}
+
+/// The spec file and the overrides of its poses per body.
+#[derive(Args, Debug)]
+pub struct SpecArg {
+    /// The spec file (TOML).
+    pub spec: PathBuf,
+    /// Samples per body of some garments instead of the spec's, e.g. tshirt=99 or
+    /// tshirt=99,sweater=54 (the dataset folder records the spec with them).
+    #[arg(long, value_name = "GARMENT=N[,GARMENT=N]")]
+    pub poses: Option<String>,
+}
+
+impl SpecArg {
+    /// The spec, its base and the `--poses` overrides resolved.
+    pub fn load(&self) -> anyhow::Result<LoadedSpec> {
+        let poses = match &self.poses {
+            Some(text) => dataset::spec_load::parse_poses_override(text)?,
+            None => Vec::new(),
+        };
+        Ok(LoadedSpec::load_with(&self.spec, &poses)?)
     }
 }
 
 /// Arguments of `garnet dataset plan`.
 #[derive(Args, Debug)]
 pub struct PlanArgs {
-    /// The spec file (TOML).
-    pub spec: PathBuf,
+    #[command(flatten)]
+    pub spec: SpecArg,
     #[command(flatten)]
     pub mocap: MocapArg,
 }
@@ -56,8 +77,8 @@ pub struct PlanArgs {
 /// Arguments of `garnet dataset generate`.
 #[derive(Args, Debug)]
 pub struct GenerateArgs {
-    /// The spec file (TOML).
-    pub spec: PathBuf,
+    #[command(flatten)]
+    pub spec: SpecArg,
     /// The dataset folder (created; an existing one of the same spec is resumed).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
@@ -122,15 +143,15 @@ pub fn run(cmd: &DatasetCmd) -> anyhow::Result<()> {
 }
 
 /// Loads the spec and its plan (reading the clips).
-fn load_plan(spec: &Path, mocap: &Path) -> anyhow::Result<(LoadedSpec, Plan)> {
-    let spec = LoadedSpec::load(spec)?;
+fn load_plan(spec: &SpecArg, mocap: Option<&Path>) -> anyhow::Result<(LoadedSpec, Plan)> {
+    let spec = spec.load()?;
     let library = dataset::poses::PoseLibrary::load(&spec.spec, mocap)?;
     let plan = Plan::new(&spec, &library.frame_counts())?;
     Ok((spec, plan))
 }
 
 fn plan(args: &PlanArgs) -> anyhow::Result<()> {
-    let (spec, plan) = load_plan(&args.spec, &args.mocap.root())?;
+    let (spec, plan) = load_plan(&args.spec, args.mocap.root().as_deref())?;
     println!(
         "spec {} ({}), hash {}",
         spec.path.display(),
@@ -183,7 +204,7 @@ fn plan(args: &PlanArgs) -> anyhow::Result<()> {
 }
 
 fn generate(args: &GenerateArgs) -> anyhow::Result<()> {
-    let spec = LoadedSpec::load(&args.spec)?;
+    let spec = args.spec.load()?;
     let model = BodyModel::load()?;
     let mut opts = GenerateOptions::new(args.mocap.root());
     if let Some(j) = args.jobs {
@@ -237,7 +258,7 @@ fn generate(args: &GenerateArgs) -> anyhow::Result<()> {
     };
     eprintln!(
         "generating {} into {} (shards {}{scope}, {} jobs)",
-        args.spec.display(),
+        args.spec.spec.display(),
         args.out.display(),
         opts.selection,
         opts.jobs

@@ -28,8 +28,12 @@ pub enum GarmentCmd {
         /// Name stored in the template (default: the file name).
         #[arg(long)]
         name: Option<String>,
-        /// Template file to write.
-        #[arg(long, default_value = "out/custom.garment")]
+        /// Template file to write, a .garment name.
+        #[arg(
+            long,
+            value_name = "FILE.garment",
+            default_value = "out/custom.garment"
+        )]
         out: PathBuf,
         /// Also write a picture of it on the template body.
         #[arg(long, value_name = "FILE.png")]
@@ -46,9 +50,10 @@ pub enum GarmentCmd {
         /// Template edge length, metres.
         #[arg(long, default_value_t = 0.01)]
         edge: f32,
-        /// Folder of the CMU clips (the walk comes from 02/02_01.amc).
-        #[arg(long, value_name = "DIR", default_value = "../shared/mocap/cmu")]
-        mocap: PathBuf,
+        /// Folder of the CMU clips (the walk comes from 02/02_01.amc; default:
+        /// $GARNET_MOCAP/cmu).
+        #[arg(long, value_name = "DIR")]
+        mocap: Option<PathBuf>,
     },
 }
 
@@ -98,8 +103,8 @@ pub struct MakeArgs {
     /// leg, none at the hips and from 75% on).
     #[arg(long)]
     pub thigh: Option<f32>,
-    /// Template file to write (default out/KIND.garment).
-    #[arg(long)]
+    /// Template file to write, a .garment name (default out/KIND.garment).
+    #[arg(long, value_name = "FILE.garment")]
     pub out: Option<PathBuf>,
     /// Also write the garment mesh (.obj, .ply, .glb).
     #[arg(long, value_name = "FILE")]
@@ -167,6 +172,7 @@ pub fn run(cmd: &GarmentCmd) -> anyhow::Result<()> {
             out,
             png,
         } => {
+            check_template_path(out, "")?;
             let mesh = geom::io::read_mesh(file)?;
             let name = name
                 .clone()
@@ -176,7 +182,8 @@ pub fn run(cmd: &GarmentCmd) -> anyhow::Result<()> {
             picture_on_template_body(&model, &template, png.as_deref())
         }
         GarmentCmd::Sheet { out, edge, mocap } => {
-            crate::garment_sheet::write_sheet(&model, out, *edge, mocap)
+            let mocap = crate::pose_args::cmu_folder(mocap.as_deref(), "garment sheet")?;
+            crate::garment_sheet::write_sheet(&model, out, *edge, &mocap)
         }
         GarmentCmd::Warp(args) => {
             let template = GarmentTemplate::load(&args.template)?;
@@ -216,6 +223,14 @@ pub fn run(cmd: &GarmentCmd) -> anyhow::Result<()> {
 
 fn make(model: &BodyModel, args: &MakeArgs) -> anyhow::Result<()> {
     let kind: GarmentKind = args.kind.into();
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("out/{}.garment", kind.name())));
+    check_template_path(
+        &out,
+        " (the mesh alone is written with --mesh FILE.obj|ply|glb)",
+    )?;
     let d = CutParams::default_for(&kind);
     let cut = CutParams {
         body_length: args.body_length.unwrap_or(d.body_length),
@@ -237,15 +252,36 @@ fn make(model: &BodyModel, args: &MakeArgs) -> anyhow::Result<()> {
         template.mesh.faces.len(),
         t0.elapsed().as_secs_f32()
     );
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("out/{}.garment", kind.name())));
     save(&template, &out)?;
     if let Some(path) = &args.mesh {
         write_mesh(path, &template.mesh)?;
     }
     picture_on_template_body(model, &template, args.png.as_deref())
+}
+
+/// Errors unless `out` is a `.garment` file name: a template is never written under a
+/// mesh's name. `hint` ends the message.
+fn check_template_path(out: &Path, hint: &str) -> anyhow::Result<()> {
+    let ext = out.extension().and_then(|e| e.to_str());
+    if ext.is_some_and(|e| e.eq_ignore_ascii_case("garment")) {
+        return Ok(());
+    }
+    let mesh = matches!(
+        ext.map(str::to_ascii_lowercase).as_deref(),
+        Some("obj" | "ply" | "glb")
+    );
+    if mesh && !hint.is_empty() {
+        anyhow::bail!(
+            "--out {}: --out writes the template, under a .garment name; to write the mesh, \
+             use --mesh {}",
+            out.display(),
+            out.display()
+        );
+    }
+    anyhow::bail!(
+        "--out {}: --out writes the template, under a .garment name{hint}",
+        out.display()
+    )
 }
 
 fn save(template: &GarmentTemplate, out: &Path) -> anyhow::Result<()> {

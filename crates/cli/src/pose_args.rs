@@ -8,6 +8,22 @@ use body::self_contact::sample_valid_pose;
 use body::{BodyModel, Pose, ShapedBody};
 use clap::{Args, ValueEnum};
 
+/// The folder of the CMU clips (with `01/` and `02/` inside) that a picture sheet poses its
+/// bodies with: `mocap` (`--mocap DIR`), else `$GARNET_MOCAP/cmu`; an error saying how to
+/// give it when neither is there. `what` names the command in the error.
+pub fn cmu_folder(mocap: Option<&Path>, what: &str) -> anyhow::Result<PathBuf> {
+    if let Some(dir) = mocap {
+        return Ok(dir.to_path_buf());
+    }
+    match std::env::var_os("GARNET_MOCAP") {
+        Some(root) => Ok(PathBuf::from(root).join("cmu")),
+        None => bail!(
+            "{what} poses its bodies with CMU clips: give their folder (holding 01/ and 02/) \
+             with --mocap DIR, or set GARNET_MOCAP to the folder holding cmu/"
+        ),
+    }
+}
+
 /// Body pose: rest A-pose by default.
 #[derive(Args, Debug, Clone, Default)]
 pub struct PoseArgs {

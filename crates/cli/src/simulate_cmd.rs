@@ -82,9 +82,10 @@ pub struct SimulateArgs {
     /// it does not name keep their default cut.
     #[arg(long = "cut", value_name = "KIND:SETTINGS")]
     pub cuts: Vec<String>,
-    /// With --sheet: folder of the CMU clips.
-    #[arg(long, value_name = "DIR", default_value = "../shared/mocap/cmu")]
-    pub mocap: PathBuf,
+    /// With --sheet: folder of the CMU clips, with 01/ and 02/ inside (default:
+    /// $GARNET_MOCAP/cmu).
+    #[arg(long, value_name = "DIR")]
+    pub mocap: Option<PathBuf>,
 }
 
 pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
@@ -95,7 +96,8 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
             edge: args.edge,
             cuts: args.cuts.clone(),
         };
-        return crate::simulate_sheet::write_sheet(&model, sheet, &args.mocap, &templates, &opts);
+        let mocap = args.mocap.as_deref();
+        return crate::simulate_sheet::write_sheet(&model, sheet, mocap, &templates, &opts);
     }
     let path = args
         .template

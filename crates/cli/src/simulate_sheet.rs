@@ -84,11 +84,12 @@ impl SheetTemplates {
 }
 
 /// Runs the thirty drapes with `templates`, writes `png`, and the statistics beside it
-/// (`.json`, `.md`).
+/// (`.json`, `.md`). `mocap` is `--mocap` (see [`crate::pose_args::cmu_folder`]), needed
+/// once the cuts are checked.
 pub fn write_sheet(
     model: &BodyModel,
     png: &Path,
-    mocap: &Path,
+    mocap: Option<&Path>,
     templates: &SheetTemplates,
     opts: &DrapeOptions,
 ) -> anyhow::Result<()> {
@@ -109,6 +110,7 @@ pub fn write_sheet(
         .iter()
         .map(|k| templates.cut(k))
         .collect::<anyhow::Result<Vec<_>>>()?;
+    let mocap = &crate::pose_args::cmu_folder(mocap, "simulate --sheet")?;
     let cut_note: String = templates.cuts.iter().map(|c| format!(", {c}")).collect();
     let mut sheet = Sheet::new(10).with_title(format!(
         "garnet simulate: 30 drapes, templates with {} cm edges{cut_note}",

@@ -2,14 +2,9 @@
 
 mod common;
 
-use common::{fails, ok, repo, s};
+use common::{fails, mocap_fixture, ok, s};
 use std::path::PathBuf;
 use std::process::Command;
-
-fn mocap() -> Option<PathBuf> {
-    let dir = repo().join("../shared/mocap/cmu");
-    dir.is_dir().then_some(dir)
-}
 
 #[test]
 fn assets_path_reports_the_body_file() {
@@ -81,11 +76,8 @@ fn body_refuses_bad_parameters_and_files() {
 
 #[test]
 fn pose_convert_then_body_from_bvh_and_amc() {
-    let Some(mocap) = mocap() else {
-        eprintln!("skipped: ../shared/mocap not present");
-        return;
-    };
     let dir = tempfile::tempdir().unwrap();
+    let mocap = mocap_fixture(dir.path(), &[("cmu/02/02_01.amc", 240)]).join("cmu");
     let bvh = dir.path().join("walk.bvh");
     let (asf, amc) = (mocap.join("02/02.asf"), mocap.join("02/02_01.amc"));
     ok(&[
@@ -136,15 +128,34 @@ fn pose_convert_then_body_from_bvh_and_amc() {
 
 #[test]
 fn body_sheet_renders_five_shapes_in_five_poses() {
-    let Some(mocap) = mocap() else {
-        eprintln!("skipped: ../shared/mocap not present");
-        return;
-    };
     let dir = tempfile::tempdir().unwrap();
+    // The frames the sheet reads: the walk up to 140, the climb up to 3000, the BVH
+    // column's clip up to 1000.
+    let clips = [
+        ("cmu/02/02_01.amc", 240),
+        ("cmu/01/01_02.amc", 3100),
+        ("cmu/02/02_05.amc", 1100),
+    ];
+    let mocap = mocap_fixture(dir.path(), &clips).join("cmu");
     let png = dir.path().join("sheet.png");
     ok(&["body", "--sheet", s(&png), "--mocap", s(&mocap)]);
     let image = render::Image::from_png(&png).unwrap();
     assert!(image.width > 1000 && image.height > 1000);
+    // Without --mocap (and without GARNET_MOCAP) the error says how to give the clips.
+    let out = Command::new(env!("CARGO_BIN_EXE_garnet"))
+        .args(["body", "--sheet", s(&png)])
+        .env_remove("GARNET_MOCAP")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("--mocap DIR"),
+        "{err}"
+    );
+    assert!(
+        err.contains("GARNET_MOCAP") && !err.contains("panicked"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -256,6 +267,15 @@ fn garment_commands_refuse_bad_input() {
         assert!(err.contains(name), "{err}");
     }
     assert!(!p("t.garment").exists());
+    // --out writes the template only, under a .garment name; the mesh is --mesh.
+    let err = fails(&["garment", "make", "tshirt", "--out", s(&p("t.obj"))]);
+    assert!(
+        err.contains("t.obj") && err.contains(".garment") && err.contains("--mesh"),
+        "{err}"
+    );
+    let err = fails(&["garment", "make", "tshirt", "--out", s(&p("t"))]);
+    assert!(err.contains(".garment"), "{err}");
+    assert!(!p("t.obj").exists() && !p("t").exists());
     // A box a metre away from the body is not a garment for it.
     let mut cube = geom::TriMesh::cuboid(glam::Vec3::splat(0.15));
     cube.vertices
@@ -361,10 +381,10 @@ fn simulate_skins_with_linear_blending_so_raised_shoulders_fit_the_armholes() {
 }
 
 /// Jeans get the elastic waistband by default: its stretch is reported apart from the
-/// cloth's. A settings file drapes as a dataset spec does, without the band unless it asks
-/// for one (`waistband = true`).
+/// cloth's. A settings file drapes as a dataset spec does: with the band unless it turns it
+/// off (`waistband = false`).
 #[test]
-fn simulate_gives_jeans_an_elastic_waistband_unless_a_settings_file_leaves_it_out() {
+fn simulate_gives_jeans_an_elastic_waistband_unless_a_settings_file_turns_it_off() {
     let dir = tempfile::tempdir().unwrap();
     let template = template(dir.path(), "jeans", "0.03");
     let band = |file: Option<&str>| {
@@ -380,15 +400,15 @@ fn simulate_gives_jeans_an_elastic_waistband_unless_a_settings_file_leaves_it_ou
             st["strain_p99"].as_f64().unwrap(),
         )
     };
-    let (default, plain, asked) = (
+    let (default, plain, off) = (
         band(None),
         band(Some("skinning = \"lbs\"\n")),
-        band(Some("skinning = \"lbs\"\nwaistband = true\n")),
+        band(Some("skinning = \"lbs\"\nwaistband = false\n")),
     );
     // Cut to 90% of the waist's girth, the band is stretched by 11% or more.
     assert!(default.0 > 0.1, "{default:?}");
-    assert_eq!(asked, default);
-    assert_eq!(plain.0, 0.0);
+    assert_eq!(plain, default);
+    assert_eq!(off.0, 0.0);
 }
 
 /// `--simulator` reads a spec's `[simulator]` keys (bare or under the header, beside other

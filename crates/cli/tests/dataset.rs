@@ -3,17 +3,33 @@
 
 mod common;
 
-use common::{fails, ok, repo, s};
-use std::path::PathBuf;
+use common::{fails, mocap_fixture, ok, repo, s};
+use std::path::{Path, PathBuf};
+use std::process::Command;
 
-fn mocap() -> Option<PathBuf> {
-    let dir = repo().join("../shared/mocap");
-    dir.is_dir().then_some(dir)
+/// Every clip the repository's specs name, as CMU-style walks garnet writes (120 frames
+/// each), in the mocap folder `root`.
+fn spec_mocap(root: &Path) -> PathBuf {
+    let clips = [
+        "cmu/01/01_01.amc",
+        "cmu/01/01_08.amc",
+        "cmu/01/01_14.amc",
+        "cmu/02/02_01.amc",
+        "cmu/02/02_02.amc",
+        "cmu/02/02_03.amc",
+        "cmu/02/02_04.amc",
+        "cmu/02/02_05.amc",
+        "cmu/02/02_06.amc",
+        "cmu/02/02_07.amc",
+        "cmu/02/02_09.amc",
+    ];
+    mocap_fixture(root, &clips.map(|c| (c, 120)))
 }
 
 /// 2 bodies x (T-shirt in 2 poses + jeans in 1): 6 samples of 8 cm garments in 3
 /// shards, a few simulator steps each.
 const FAST: &str = r#"
+format = 2
 name = "cli"
 seed = 9
 shard_size = 2
@@ -58,14 +74,19 @@ fn plan_describes_specs_and_names_bad_fields() {
         err.contains("bad.toml") && err.contains("garments[0].edge"),
         "{err}"
     );
-    let Some(mocap) = mocap() else {
-        eprintln!("skipped the repository specs: ../shared/mocap not present");
-        return;
-    };
-    for name in ["tiny", "standard", "standard-x3", "tshirt-large", "paper"] {
+    let mocap = spec_mocap(&dir.path().join("mocap"));
+    for (name, samples) in [
+        ("tiny", 12),
+        ("standard-lbs", 6000),
+        ("standard-x9-lbs", 54000),
+        ("paper", 56400),
+    ] {
         let spec = repo().join(format!("specs/{name}.toml"));
         let out = ok(&["dataset", "plan", s(&spec), "--mocap", s(&mocap)]);
-        assert!(out.contains("samples in"), "{out}");
+        assert!(
+            out.contains(&format!("{samples} samples in")),
+            "{name}: {out}"
+        );
     }
     let out = ok(&[
         "dataset",
@@ -74,12 +95,65 @@ fn plan_describes_specs_and_names_bad_fields() {
         "--mocap",
         s(&mocap),
     ]);
+    assert!(out.contains("split train: 500 bodies"), "{out}");
+    // --poses replaces a garment's poses per body.
+    let x9 = repo().join("specs/standard-x9-lbs.toml");
+    let out = ok(&[
+        "dataset",
+        "plan",
+        s(&x9),
+        "--mocap",
+        s(&mocap),
+        "--poses",
+        "tshirt=99,sweater=54",
+    ]);
+    assert!(out.contains("108000 samples in"), "{out}");
+    assert!(out.contains("99 poses per body"), "{out}");
+    for (poses, says) in [
+        (
+            "hat=3",
+            "no garment 'hat' (the garments are tshirt, sweater, jeans)",
+        ),
+        ("tshirt", "GARMENT=N"),
+    ] {
+        let err = fails(&[
+            "dataset",
+            "plan",
+            s(&x9),
+            "--mocap",
+            s(&mocap),
+            "--poses",
+            poses,
+        ]);
+        assert!(err.contains(says), "{poses}: {err}");
+    }
+    // A spec that names clips needs the mocap folder; the error says how to give it.
+    let out = Command::new(env!("CARGO_BIN_EXE_garnet"))
+        .args(["dataset", "plan", s(&x9)])
+        .env_remove("GARNET_MOCAP")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        out.contains("56400 samples") && out.contains("split train: 500 bodies"),
-        "{out}"
+        !out.status.success() && err.contains("--mocap DIR or GARNET_MOCAP"),
+        "{err}"
     );
-    // A BVH clip (converted from a CMU clip) as a pose source.
-    let root = dir.path().join("mocap");
+    // The smoke-test spec generates from the clips (its first sample).
+    let tiny = dir.path().join("tiny");
+    let out = ok(&[
+        "dataset",
+        "generate",
+        s(&repo().join("specs/tiny.toml")),
+        "--out",
+        s(&tiny),
+        "--mocap",
+        s(&mocap),
+        "--max-samples",
+        "1",
+    ]);
+    assert!(out.contains("made 1 now"), "{out}");
+    // A BVH clip (converted from a walk) as a pose source.
+    let root = dir.path().join("bvh-mocap");
     std::fs::create_dir_all(&root).unwrap();
     let cmu = mocap.join("cmu/02");
     ok(&[
@@ -99,7 +173,8 @@ fn plan_describes_specs_and_names_bad_fields() {
     );
     std::fs::write(&bvh, text).unwrap();
     let out = ok(&["dataset", "plan", s(&bvh), "--mocap", s(&root)]);
-    assert!(out.contains("pose pool: 11 poses in 2 motions"), "{out}");
+    // Frames 0, 50 and 100 of the 120, and the 4 procedural poses.
+    assert!(out.contains("pose pool: 7 poses in 2 motions"), "{out}");
     let err = fails(&[
         "dataset",
         "plan",
@@ -283,6 +358,22 @@ fn generate_resume_merge_info_show() {
     assert!(
         err.contains("shard-000002.safetensors") && err.contains("checksum"),
         "{err}"
+    );
+    // A folder started with --poses resumes only with the same: its spec.toml is the
+    // resolved spec.
+    let fewer = d.join("fewer");
+    let args = ["dataset", "generate", s(&spec), "--out", s(&fewer)];
+    ok(&[&args[..], &["--poses", "tshirt=1", "--max-samples", "1"]].concat());
+    let err = fails(&args);
+    assert!(
+        err.contains("garments[0].poses_per_body: 1 -> 2") && err.contains("--poses"),
+        "{err}"
+    );
+    let recorded = fewer.join("spec.toml");
+    let out = ok(&["dataset", "generate", s(&recorded), "--out", s(&fewer)]);
+    assert!(
+        out.contains("1 of 4 selected samples were already made"),
+        "{out}"
     );
     // Another spec in the same folder is refused.
     std::fs::write(&spec, FAST.replace("seed = 9", "seed = 10")).unwrap();

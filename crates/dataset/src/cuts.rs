@@ -18,8 +18,8 @@ pub struct GarmentPlan {
     pub edge: f32,
     /// Samples per body.
     pub poses_per_body: u32,
-    /// The cut: the kind's first cut ([`CutParams::first_for`], the same in every version)
-    /// with the spec's fixed values (metres).
+    /// The cut: the kind's default cut ([`CutParams::default_for`], as `garnet garment
+    /// make` cuts it) with the spec's fixed values (metres).
     pub base: CutParams,
     /// Parameters drawn per body: `(index in RANGES, min, max)`, metres.
     pub ranges: Vec<(usize, f32, f32)>,
@@ -30,7 +30,7 @@ impl GarmentPlan {
     pub fn from_spec(spec: &GarmentSpec) -> Result<Self, (String, String)> {
         let kind = GarmentKind::parse(&spec.kind).map_err(|e| ("kind".into(), e.to_string()))?;
         let name = spec.name.clone().unwrap_or_else(|| kind.name().to_string());
-        let mut base = CutParams::first_for(&kind);
+        let mut base = CutParams::default_for(&kind);
         for (key, &v) in &spec.cut {
             let i = CutParams::index_of(key).map_err(|e| (format!("cut.{key}"), e.to_string()))?;
             *base.field_mut(i) = v;

@@ -51,8 +51,8 @@ pub struct GenerateOptions<'a> {
     /// Of those, only the shards holding a sample of one of these garments (names; empty:
     /// any garment).
     pub only_garments: Vec<String>,
-    /// The folder clip paths are relative to.
-    pub mocap_root: PathBuf,
+    /// The folder clip paths are relative to (needed when the spec names clips).
+    pub mocap_root: Option<PathBuf>,
     /// A dataset of a smaller spec whose samples are taken instead of made again (see
     /// [`crate::reuse`]).
     pub reuse: Option<PathBuf>,
@@ -66,7 +66,7 @@ pub struct GenerateOptions<'a> {
 
 impl GenerateOptions<'_> {
     /// One job per core, all shards, no limit, no hooks.
-    pub fn new(mocap_root: PathBuf) -> Self {
+    pub fn new(mocap_root: Option<PathBuf>) -> Self {
         Self {
             jobs: std::thread::available_parallelism().map_or(1, |n| n.get()),
             selection: ShardSelection::ALL,
@@ -119,7 +119,7 @@ pub fn generate(
     let t0 = Instant::now();
     opts.selection.check()?;
     let jobs = opts.jobs.max(1);
-    let library = PoseLibrary::load(&spec.spec, &opts.mocap_root)?;
+    let library = PoseLibrary::load(&spec.spec, opts.mocap_root.as_deref())?;
     let plan = Plan::new(spec, &library.frame_counts())?;
     layout::create_dirs(out)?;
     let stray_temps_removed = layout::remove_stray_temps(out)?;
@@ -201,17 +201,19 @@ fn open_manifest(
 ) -> Result<Manifest> {
     let path = layout::manifest_path(out);
     if !path.is_file() {
-        geom::io::write_bytes_atomic(spec_path(out), spec.text.as_bytes())?;
+        geom::io::write_bytes_atomic(spec_path(out), spec.resolved_toml().as_bytes())?;
         return Ok(Manifest::new(spec, plan, library.files.clone()));
     }
     let m = Manifest::load(out)?;
     if m.spec_hash != spec.hash {
         return Err(DatasetError::Invalid(format!(
-            "{} holds a dataset of another spec (hash {}), not of {} (hash {}); use another --out folder",
+            "{} holds a dataset of another spec than {} (with its base and --poses), which \
+             differs in {}; run it with the spec and --poses it was started with (its \
+             resolved spec is {}), or use another --out folder",
             out.display(),
-            m.spec_hash,
             spec.path.display(),
-            spec.hash
+            crate::spec::differences(&m.spec, &spec.spec).join(", "),
+            spec_path(out).display()
         )));
     }
     for f in &library.files {

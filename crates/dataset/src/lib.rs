@@ -41,6 +41,7 @@ pub mod shard;
 pub mod simulator;
 pub mod spec;
 pub mod spec_check;
+pub mod spec_load;
 pub mod summary;
 pub mod templates;
 pub mod tensors;

@@ -17,7 +17,7 @@ use crate::shard::ShardInfo;
 use crate::spec::{LoadedSpec, Spec};
 
 /// Format tag of manifests.
-pub const MANIFEST_FORMAT: &str = "garnet-dataset-1";
+pub const MANIFEST_FORMAT: &str = "garnet-dataset-2";
 
 /// A file of the dataset and its checksum.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -175,14 +175,25 @@ impl Manifest {
     pub fn load(dir: &Path) -> Result<Self> {
         let path = manifest_path(dir);
         let text = std::fs::read_to_string(&path).map_err(|e| DatasetError::io(&path, e))?;
-        let m: Manifest = serde_json::from_str(&text)
+        // The format first: a manifest of another format need not parse as this one.
+        let value: serde_json::Value = serde_json::from_str(&text)
             .map_err(|e| DatasetError::corrupt(&path, format!("not a dataset manifest: {e}")))?;
-        if m.format != MANIFEST_FORMAT {
+        let format = value
+            .get("format")
+            .and_then(|f| f.as_str())
+            .unwrap_or("none");
+        if format != MANIFEST_FORMAT {
             return Err(DatasetError::corrupt(
                 &path,
-                format!("format {}, expected {MANIFEST_FORMAT}", m.format),
+                format!(
+                    "format {format}, expected {MANIFEST_FORMAT}: made by another version of \
+                     garnet; generate it again with this one (from a spec of format {})",
+                    crate::spec::SPEC_FORMAT
+                ),
             ));
         }
+        let m: Manifest = serde_json::from_value(value)
+            .map_err(|e| DatasetError::corrupt(&path, format!("not a dataset manifest: {e}")))?;
         Ok(m)
     }
 

@@ -36,16 +36,30 @@ pub struct PoseLibrary {
 }
 
 impl PoseLibrary {
-    /// Loads every clip `spec` names from under `root`. Errors name the missing or
-    /// malformed file; a spec without clips needs no root.
-    pub fn load(spec: &Spec, root: &Path) -> Result<Self> {
+    /// Loads every clip `spec` names from under the mocap folder `root`. Errors name the
+    /// missing or malformed file; a spec without clips needs no root (`None`).
+    pub fn load(spec: &Spec, root: Option<&Path>) -> Result<Self> {
         let refs = clip_list(spec);
-        if !refs.is_empty() && !root.is_dir() {
-            return Err(DatasetError::Invalid(format!(
-                "the mocap root {} is not a folder: give it with --mocap DIR or GARNET_MOCAP",
-                root.display()
-            )));
-        }
+        let root = match root {
+            _ if refs.is_empty() => Path::new(""),
+            Some(root) if root.is_dir() => root,
+            Some(root) => {
+                return Err(DatasetError::Invalid(format!(
+                    "the mocap folder {} is not a folder: give the folder the spec's clip \
+                     paths are relative to with --mocap DIR or GARNET_MOCAP",
+                    root.display()
+                )))
+            }
+            None => {
+                return Err(DatasetError::Invalid(format!(
+                    "the spec names {} mocap clips (such as {}) but no mocap folder was \
+                     given: give the folder their paths are relative to with --mocap DIR or \
+                     GARNET_MOCAP",
+                    refs.len(),
+                    refs[0].path
+                )))
+            }
+        };
         let mut files: Vec<MocapFile> = Vec::new();
         let mut note = |rel: &str| -> Result<PathBuf> {
             let path = root.join(rel);

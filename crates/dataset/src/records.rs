@@ -32,16 +32,12 @@ pub struct SimStats {
     /// Whether the cloth came to rest within the step budget.
     pub converged: bool,
     /// The largest turn of a limb joint by the pose's clearance correction, degrees.
-    #[serde(default)]
     pub limb_turn_deg: f32,
     /// Walks of garment vertices out of the body the shortest way (caught between
     /// overlapping body parts; see `sim::stats::DrapeStats::walked_out`).
-    #[serde(default)]
     pub walked_out: u32,
-    /// How far the garment slid on the body, metres (`sim::stats::DrapeStats::slid_m`);
-    /// absent in samples made before it was measured.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub slid_m: Option<f32>,
+    /// How far the garment slid on the body, metres (`sim::stats::DrapeStats::slid_m`).
+    pub slid_m: f32,
 }
 
 impl From<&DrapeStats> for SimStats {
@@ -59,7 +55,7 @@ impl From<&DrapeStats> for SimStats {
             converged: s.converged,
             limb_turn_deg: s.limb_turn_deg,
             walked_out: s.walked_out,
-            slid_m: Some(s.slid_m),
+            slid_m: s.slid_m,
         }
     }
 }
@@ -74,7 +70,7 @@ pub struct DrapeFilter {
     /// Keep only drapes whose strain p99 is at most this (a fraction, 0.05 = 5%).
     pub max_strain_p99: Option<f32>,
     /// Keep only drapes whose garment slid at most this far on the body (metres,
-    /// [`SimStats::slid_m`]); drapes made before the slide was measured are kept.
+    /// [`SimStats::slid_m`]).
     pub max_slid_m: Option<f32>,
 }
 
@@ -83,9 +79,7 @@ impl DrapeFilter {
     pub fn keeps(&self, s: &SimStats) -> bool {
         (!self.at_rest || s.converged)
             && self.max_strain_p99.is_none_or(|m| s.strain_p99 <= m)
-            && self
-                .max_slid_m
-                .is_none_or(|m| s.slid_m.is_none_or(|d| d <= m))
+            && self.max_slid_m.is_none_or(|m| s.slid_m <= m)
     }
 
     /// The filter in words ("drapes at rest with strain p99 at most 5%").
@@ -186,7 +180,7 @@ mod tests {
         };
         assert!(f.keeps(&ok) && !f.keeps(&restless) && !f.keeps(&strained));
         assert_eq!(f.describe(), "drapes at rest with strain p99 at most 5%");
-        let slid = |d: Option<f32>| SimStats {
+        let slid = |d: f32| SimStats {
             slid_m: d,
             ..ok.clone()
         };
@@ -194,30 +188,11 @@ mod tests {
             max_slid_m: Some(0.1),
             ..f
         };
-        assert!(g.keeps(&slid(Some(0.04))) && g.keeps(&slid(None)));
-        assert!(!g.keeps(&slid(Some(0.17))) && !g.keeps(&restless));
+        assert!(g.keeps(&slid(0.04)) && g.keeps(&slid(0.1)));
+        assert!(!g.keeps(&slid(0.17)) && !g.keeps(&restless));
         assert_eq!(
             g.describe(),
             "drapes at rest with strain p99 at most 5% and whose garment slid at most 10 cm"
         );
-    }
-
-    #[test]
-    fn records_made_before_the_slide_was_measured_read_and_write_as_before() {
-        let old = SimStats {
-            converged: true,
-            ..Default::default()
-        };
-        let text = serde_json::to_string(&old).unwrap();
-        assert!(!text.contains("slid_m"), "{text}");
-        let back: SimStats = serde_json::from_str(&text).unwrap();
-        assert_eq!(back.slid_m, None);
-        let new = SimStats::from(&DrapeStats {
-            slid_m: 0.04,
-            ..Default::default()
-        });
-        let text = serde_json::to_string(&new).unwrap();
-        let back: SimStats = serde_json::from_str(&text).unwrap();
-        assert_eq!(back.slid_m, Some(0.04));
     }
 }

@@ -79,7 +79,6 @@ impl Reuse {
             hash: crate::spec::spec_hash(&old),
             spec: old,
             path: crate::layout::spec_path(dir),
-            text: String::new(),
         };
         Ok(Self {
             plan: Plan::new(&old_spec, &library.frame_counts())?,

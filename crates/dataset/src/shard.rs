@@ -21,7 +21,7 @@ use crate::tensors::{self, RawTensor};
 pub const SHARD_KEY: &str = "garnet_dataset_shard";
 
 /// Format tag of shard files.
-pub const SHARD_FORMAT: &str = "garnet-dataset-shard-1";
+pub const SHARD_FORMAT: &str = "garnet-dataset-shard-2";
 
 /// The metadata of a shard.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -46,11 +46,11 @@ impl SimulatorSpec {
         set(&mut o.explode_speed, self.explode_speed);
         set(&mut o.max_penetration, self.max_penetration);
         o.grade = self.grade.unwrap_or(o.grade);
-        if !self.waistband.unwrap_or(false) {
-            o.waistband = None;
+        match self.waistband {
+            Some(false) => o.waistband = None,
+            Some(true) => o.waistband = o.waistband.or_else(|| Some(Default::default())),
+            None => {}
         }
-        // Datasets skin with DQS unless their spec says otherwise (see the field's doc).
-        o.skinning = Skinning::Dqs;
         if let Some(s) = &self.skinning {
             o.skinning = Skinning::from_name(s).ok_or_else(|| {
                 (
@@ -119,17 +119,19 @@ mod tests {
         assert_eq!(o.cloth.friction, 0.2);
         assert_eq!(o.skinning, Skinning::Lbs);
         assert_eq!(o.pose_steps, DrapeOptions::default().pose_steps);
-        // A spec without a skinning keeps DQS, whatever the simulator's default: the
-        // datasets made before the default became LBS rebuild their bodies with it.
+        // A spec that names nothing gets the simulator's defaults.
         let plain = SimulatorSpec::default().drape_options().unwrap();
-        assert_eq!(plain.skinning, Skinning::Dqs);
-        assert_eq!(plain.waistband, None);
-        let banded = SimulatorSpec {
-            waistband: Some(true),
+        let defaults = DrapeOptions::default();
+        assert_eq!(plain.skinning, defaults.skinning);
+        assert_eq!(plain.waistband, defaults.waistband);
+        assert!(plain.waistband.is_some());
+        let bare = SimulatorSpec {
+            waistband: Some(false),
+            skinning: Some("dqs".into()),
             ..Default::default()
         };
-        assert!(banded.drape_options().unwrap().waistband.is_some());
-        assert_eq!(DrapeOptions::default().skinning, Skinning::Lbs);
+        let bare = bare.drape_options().unwrap();
+        assert_eq!((bare.waistband, bare.skinning), (None, Skinning::Dqs));
         let bad = SimulatorSpec {
             density: Some(-1.0),
             ..Default::default()

@@ -2,6 +2,7 @@
 //! pose sources, the counts, the seed, the splits and the simulator settings.
 //!
 //! ```toml
+//! format = 2                      # the spec format (crate::spec_load::SPEC_FORMAT)
 //! name = "tiny"
 //! seed = 1
 //! shard_size = 32                 # samples per shard file
@@ -40,6 +41,8 @@
 //! compact = false                 # store no body and no M: readers rebuild them
 //! ```
 //!
+//! A field left out gets the simulator's and the garments' current defaults. A spec may
+//! instead name a `base` spec and give only what differs (see [`crate::spec_load`]).
 //! Unknown keys are errors; [`LoadedSpec::load`] validates every field and names the file
 //! and the field in its errors.
 
@@ -50,11 +53,14 @@ use body::shape_sampler::ShapeDistribution;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{DatasetError, Result};
+pub use crate::spec_load::SPEC_FORMAT;
 
 /// A dataset specification (see the module documentation for the TOML form).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Spec {
+    /// The spec format, [`SPEC_FORMAT`].
+    pub format: i64,
     /// Free-text name of the dataset.
     #[serde(default)]
     pub name: String,
@@ -230,9 +236,7 @@ pub struct SimulatorSpec {
     /// Steps of the move into the pose.
     pub pose_steps: Option<u32>,
     /// Most distance a body vertex travels in one animation step, metres (0: always the
-    /// full step counts). Left out of the canonical JSON when absent, so the hash of every
-    /// spec written before it existed stays the same (its datasets still resume).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// full step counts).
     pub body_step: Option<f32>,
     /// Most settling steps.
     pub max_settle_steps: Option<u32>,
@@ -242,17 +246,13 @@ pub struct SimulatorSpec {
     pub explode_speed: Option<f32>,
     /// Deepest garment vertex allowed inside the body, metres.
     pub max_penetration: Option<f32>,
-    /// Skinning of the body during the animation: `dqs` or `lbs`; `dqs` when absent (the
-    /// simulator's default until session 13, kept so that every dataset made before
-    /// means what it meant; its bodies are rebuilt with it).
+    /// Skinning of the body during the animation (and of the bodies a reader rebuilds):
+    /// `lbs` or `dqs`; the simulator's default when absent.
     pub skinning: Option<String>,
     /// Grade the garment to the target body.
     pub grade: Option<bool>,
     /// Give a garment with a waistband (the jeans) its elastic band
-    /// (`sim::waistband::Waistband::default`); off when absent, so every dataset made
-    /// before it existed drapes as it did. Left out of the canonical JSON when absent (the
-    /// hashes of earlier specs stay the same).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// (`sim::waistband::Waistband::default`); the simulator's default (on) when absent.
     pub waistband: Option<bool>,
 }
 
@@ -266,54 +266,90 @@ pub struct OutputSpec {
     /// Store neither the posed body nor M: both follow from the phenotype, the pose and
     /// the template, and [`crate::Dataset::sample`] rebuilds them (with the body model).
     /// A sample then takes about a tenth of the space.
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    #[serde(default)]
     pub compact: bool,
 }
 
-/// A spec read from a file: the parsed spec, its source, and its hash.
+/// A spec read from a file: the resolved spec (its base and overrides applied), its
+/// source, and its hash.
 #[derive(Clone, Debug)]
 pub struct LoadedSpec {
-    /// The parsed, validated spec.
+    /// The parsed, resolved, validated spec.
     pub spec: Spec,
     /// The file it came from (named in errors).
     pub path: PathBuf,
-    /// The TOML text as read.
-    pub text: String,
     /// Hex sha256 of the spec's canonical JSON: equal for specs that mean the same,
-    /// whatever their comments and layout.
+    /// whatever their comments, layout and bases.
     pub hash: String,
 }
 
 impl LoadedSpec {
-    /// Reads, parses and validates the spec at `path`.
+    /// Reads, resolves and validates the spec at `path`.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| DatasetError::io(path, e))?;
-        Self::parse(&text, path)
+        Self::load_with(path, &[])
     }
 
-    /// Parses and validates `text`; `path` is named in errors.
+    /// [`LoadedSpec::load`] with the poses per body of some garments replaced:
+    /// `(garment name, samples per body)` (see [`crate::spec_load::parse_poses_override`]).
+    pub fn load_with(path: &Path, poses: &[(String, u32)]) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| DatasetError::io(path, e))?;
+        Self::parse_with(&text, path, poses)
+    }
+
+    /// Parses, resolves and validates `text`; `path` is named in errors, and a `base` is
+    /// found relative to its folder.
     pub fn parse(text: &str, path: &Path) -> Result<Self> {
-        let table: toml::Table = toml::from_str(text).map_err(|e| toml_error(path, text, e))?;
+        Self::parse_with(text, path, &[])
+    }
+
+    /// [`LoadedSpec::parse`] with the poses overrides of [`LoadedSpec::load_with`].
+    pub fn parse_with(text: &str, path: &Path, poses: &[(String, u32)]) -> Result<Self> {
+        let (mut table, merged) = crate::spec_load::resolve(text, path)?;
+        crate::spec_load::override_poses(&mut table, poses, path)?;
         check_distribution_keys(&table, path)?;
-        let spec: Spec = toml::from_str(text).map_err(|e| toml_error(path, text, e))?;
+        let spec: Spec = if merged || !poses.is_empty() {
+            Spec::deserialize(toml::Value::Table(table))
+                .map_err(|e| DatasetError::spec(path, "spec (with its base)", e.message()))?
+        } else {
+            // From the text itself, so that errors name the line.
+            toml::from_str(text).map_err(|e| toml_error(path, text, e))?
+        };
         crate::spec_check::validate(&spec, path)?;
         Ok(Self {
             hash: spec_hash(&spec),
             spec,
             path: path.to_path_buf(),
-            text: text.to_string(),
         })
+    }
+
+    /// The resolved spec as a TOML spec file (no base, every override applied): what a
+    /// dataset folder keeps as `spec.toml`.
+    pub fn resolved_toml(&self) -> String {
+        let body = toml::to_string(&self.spec).expect("a spec serialises as TOML");
+        format!(
+            "# The resolved spec of this dataset (its base and overrides applied), as garnet \
+             wrote it.\n{body}"
+        )
     }
 }
 
 impl SimulatorSpec {
     /// Reads simulator settings from the TOML file at `path`: the keys of a spec's
     /// `[simulator]` table, either under a `[simulator]` header (so a dataset spec itself
-    /// gives its simulator settings) or at the top level of the file. Errors name the file
+    /// gives its simulator settings, with those of its base) or at the top level of the
+    /// file. Errors name the file
     /// and the line or key at fault; an unknown key is one.
     pub fn load(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|e| DatasetError::io(path, e))?;
         let table: toml::Table = toml::from_str(&text).map_err(|e| toml_error(path, &text, e))?;
+        if table.contains_key("base") {
+            // A dataset spec over a base: its simulator settings, merged with the base's.
+            let (merged, _) = crate::spec_load::resolve(&text, path)?;
+            let settings = merged.get("simulator").cloned();
+            let settings = settings.unwrap_or_else(|| toml::Value::Table(toml::Table::new()));
+            return SimulatorSpec::deserialize(settings)
+                .map_err(|e| DatasetError::spec(path, "simulator", e.message()));
+        }
         if table.contains_key("simulator") {
             /// A file with a `[simulator]` table and anything else beside it.
             #[derive(Deserialize)]
@@ -328,6 +364,44 @@ impl SimulatorSpec {
     }
 }
 
+/// The fields in which spec `was` differs from `now`, each as `field: WAS -> NOW` (a
+/// dotted path with indices, `garments[0].poses_per_body: 36 -> 99`).
+pub fn differences(was: &Spec, now: &Spec) -> Vec<String> {
+    fn walk(path: &str, a: &serde_json::Value, b: &serde_json::Value, out: &mut Vec<String>) {
+        use serde_json::Value;
+        match (a, b) {
+            (Value::Object(x), Value::Object(y)) => {
+                let keys: std::collections::BTreeSet<&String> = x.keys().chain(y.keys()).collect();
+                for k in keys {
+                    let (u, v) = (&x.get(k), &y.get(k));
+                    let here = if path.is_empty() {
+                        k.clone()
+                    } else {
+                        format!("{path}.{k}")
+                    };
+                    walk(
+                        &here,
+                        u.unwrap_or(&Value::Null),
+                        v.unwrap_or(&Value::Null),
+                        out,
+                    );
+                }
+            }
+            (Value::Array(x), Value::Array(y)) if x.len() == y.len() => {
+                for (i, (u, v)) in x.iter().zip(y).enumerate() {
+                    walk(&format!("{path}[{i}]"), u, v, out);
+                }
+            }
+            _ if a != b => out.push(format!("{path}: {a} -> {b}")),
+            _ => {}
+        }
+    }
+    let json = |s: &Spec| serde_json::to_value(s).expect("a spec serialises");
+    let mut out = Vec::new();
+    walk("", &json(was), &json(now), &mut out);
+    out
+}
+
 /// Hex sha256 of the canonical JSON of `spec`.
 pub fn spec_hash(spec: &Spec) -> String {
     let json = serde_json::to_string(spec).expect("a spec serialises");
@@ -336,7 +410,7 @@ pub fn spec_hash(spec: &Spec) -> String {
 
 /// A TOML syntax or type error as a spec error: the field is the line it is on (1-based)
 /// and that line's text.
-fn toml_error(path: &Path, text: &str, e: toml::de::Error) -> DatasetError {
+pub(crate) fn toml_error(path: &Path, text: &str, e: toml::de::Error) -> DatasetError {
     let field = match e.span() {
         Some(span) => {
             let at = span.start.min(text.len());

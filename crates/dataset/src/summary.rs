@@ -73,10 +73,8 @@ pub struct Summary {
     pub strain_p99_pct: Spread,
     /// Largest edge strain per drape, percent.
     pub strain_max_pct: Spread,
-    /// How far each garment slid on the body, cm, over the drapes that measured it.
+    /// How far each garment slid on the body per drape, cm.
     pub slid_cm: Spread,
-    /// Drapes that measured how far their garment slid (made since it was recorded).
-    pub slid_known: usize,
     /// Failures: (sample index, garment, reason).
     pub failures: Vec<(u64, String, String)>,
 }
@@ -119,12 +117,7 @@ impl Summary {
         s.max_penetration_mm = col(&|x| x.max_penetration_m as f64 * 1e3);
         s.strain_p99_pct = col(&|x| x.strain_p99 as f64 * 100.0);
         s.strain_max_pct = col(&|x| x.strain_max as f64 * 100.0);
-        let slid: Vec<f64> = stats
-            .iter()
-            .filter_map(|x| x.slid_m.map(|d| d as f64 * 100.0))
-            .collect();
-        s.slid_known = slid.len();
-        s.slid_cm = Spread::of(&slid);
+        s.slid_cm = col(&|x| x.slid_m as f64 * 100.0);
         s.converged_share =
             stats.iter().filter(|x| x.converged).count() as f64 / stats.len().max(1) as f64;
         let times: Vec<_> = m.samples.iter().filter_map(|e| e.timing).collect();
@@ -185,10 +178,7 @@ impl Summary {
         row(&mut o, "max penetration", &self.max_penetration_mm, "mm");
         row(&mut o, "strain p99", &self.strain_p99_pct, "%");
         row(&mut o, "strain max", &self.strain_max_pct, "%");
-        if self.slid_known > 0 {
-            let name = format!("slid ({} drapes)", self.slid_known);
-            row(&mut o, &name, &self.slid_cm, "cm");
-        }
+        row(&mut o, "slid", &self.slid_cm, "cm");
         let _ = writeln!(
             o,
             "  at rest: {:.1}% of drapes",

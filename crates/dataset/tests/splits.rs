@@ -8,6 +8,7 @@ use std::path::Path;
 use dataset::{LoadedSpec, Manifest, Plan};
 
 const SPEC: &str = r#"
+format = 2
 seed = 17
 shard_size = 8
 [bodies]
@@ -200,7 +201,8 @@ fn datasets_drawing_bodies_alike_share_bodies_split_by_split() {
         Manifest::new(&spec, &Plan::new(&spec, &FRAMES).unwrap(), Vec::new())
     };
     let base = manifest(SPEC);
-    // More poses per body (as standard-x3 to standard): the same bodies in the same splits.
+    // More poses per body (as standard-x9-lbs to standard-lbs): the same bodies in the same
+    // splits.
     let more = manifest(&SPEC.replace("poses_per_body = 6", "poses_per_body = 18"));
     assert!(more
         .shared_bodies("train", &base, "test")

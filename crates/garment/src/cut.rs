@@ -128,10 +128,10 @@ impl CutParams {
     /// more over the thighs and knees) up to the natural waist (`waist_height` 0.10, where
     /// the body is narrower than the hips, so the simulator's elastic waistband holds them
     /// up), following the body's hollows (`bridge` 0: more cloth behind the knees and in the
-    /// seat). Measured on the 30-drape sheet at 1 cm: session 15, 26 drapes at rest under 2%
-    /// strain p99 (every top, 6 of 10 jeans), against 21 with the
-    /// [`first_for`](Self::first_for) cut; session 17, with the waistband, all 30 (without
-    /// the thigh room 9 of 10 jeans, with `bridge` 0.5 7).
+    /// seat). Measured on the 30-drape sheet at 1 cm: 26 drapes at rest under 2% strain p99
+    /// (every top, 6 of 10 jeans), against 21 with the [`first_for`](Self::first_for) cut;
+    /// with the waistband, all 30 (without the thigh room 9 of 10 jeans, with `bridge` 0.5
+    /// 7).
     pub fn default_for(kind: &GarmentKind) -> Self {
         let first = Self::first_for(kind);
         match kind {
@@ -151,9 +151,9 @@ impl CutParams {
         }
     }
 
-    /// The cut garnet's garments had before session 15 (tops without flare, bridging the
-    /// armpits): what a dataset spec's garment gets where it names no cut, so a spec makes
-    /// the same garments in every version.
+    /// The first cut of garnet's garments (tops without flare, bridging the armpits): the
+    /// cut [`default_for`](Self::default_for) starts from, and the one the benchmark dataset
+    /// spec (`specs/standard-lbs.toml`) names in full.
     pub fn first_for(kind: &GarmentKind) -> Self {
         match kind {
             GarmentKind::Sweater => Self {

@@ -135,7 +135,7 @@ mod tests {
         assert_eq!(legend.width, 200);
     }
 
-    /// Regression (session 55): twelve curves of one chart must not share a colour. Any two
+    /// Regression: twelve curves of one chart must not share a colour. Any two
     /// curve colours differ by at least 40 (of 255) in some channel.
     #[test]
     fn curve_colours_are_distinct() {

@@ -447,7 +447,7 @@ impl BodyCollider {
 
     /// The face and smooth vertex normals at `cur`. The edge and vertex pseudo-normals are
     /// worked out where a query needs one: a step asks for a few hundred of them, and a
-    /// pass over every face for all of them was about 4% of a dataset drape (session 42).
+    /// pass over every face for all of them was about 4% of a dataset drape.
     fn update_normals(&mut self) {
         self.face_normals = geom::normals::face_normals(&self.cur, &self.faces);
         self.vertex_normals = geom::normals::vertex_normals(&self.cur, &self.faces);

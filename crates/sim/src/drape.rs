@@ -52,8 +52,7 @@ pub struct DrapeOptions {
     /// How the body is skinned during the animation (and so the body the garment rests on).
     /// Linear blending by default: dual quaternion skinning keeps a joint's volume by
     /// bulging it, and a shoulder raised overhead then outgrows the armhole, which no
-    /// garment can fit without stretching. Measured on the 30-drape sheet at 1 cm (session
-    /// 13): the arms-up drapes' strain p99 fell from 23.7 / 18.3% to 11.6 / 4.1% (T-shirt
+    /// garment can fit without stretching. Measured on the 30-drape sheet at 1 cm: the arms-up drapes' strain p99 fell from 23.7 / 18.3% to 11.6 / 4.1% (T-shirt
     /// yoga 103 / 109) and from 13.4 / 8.1% to 2.2 / 6.3% (sweater), one more drape came
     /// to rest (25 of 30), and as many ended under 2% (21).
     pub skinning: Skinning,

@@ -53,7 +53,7 @@ pub struct ClothParams {
     /// column alone. Splitting makes a lone drape faster (`garnet bench sim`, medians: 1.27
     /// against 1.44 s at 2.5 cm), but it walks the factor twice, which costs more than it
     /// gains where other drapes keep every thread busy (the dataset's workers: 27.3 against
-    /// 31.8 s of CPU for 18 drapes on two jobs; README "Simulator", session 42).
+    /// 31.8 s of CPU for 18 drapes on two jobs; README "Simulator").
     pub split_solve: bool,
 }
 

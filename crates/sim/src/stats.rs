@@ -51,7 +51,7 @@ pub struct DrapeStats {
     /// 90th percentile of the stretch of the body's skin under the garment: over the body
     /// edges of the faces the garment touches (a vertex within [`SKIN_TOUCH_M`]), the
     /// posed length over the rest-pose length, minus 1. Cloth held by friction stretches
-    /// with the skin or slides. On the 1 cm sheet (session 14) the drapes that fail (not at
+    /// with the skin or slides. On the 1 cm sheet the drapes that fail (not at
     /// rest, or strain p99 over 2%) are, per garment, exactly those with the most stretched
     /// skin: tops 22.8-38.3% against at most 20.1%, jeans 5.3-15.6% against at most 4.0%.
     #[serde(default)]

@@ -29,7 +29,7 @@ pub struct Waistband {
 
 impl Default for Waistband {
     /// A 4 cm band cut to 90% of the body's girth, 0.7 times as stiff as the cloth.
-    /// Measured at 1 cm on the 30-drape sheet's ten jeans (session 17, jeans cut with
+    /// Measured at 1 cm on the 30-drape sheet's ten jeans (jeans cut with
     /// `waist_height 0.10`, 2-4 cm ease): a band a tenth as stiff let the looser jeans slide
     /// (ease 4 cm: 2 of 10 still sliding after 400 settling steps, against none at 0.2 and
     /// 0.3); cut to 85% of the girth it held as well, but pressed the skin's facets through

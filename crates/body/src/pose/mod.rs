@@ -18,6 +18,7 @@ pub mod procedural;
 mod retarget;
 mod source;
 pub mod synthetic;
+pub mod synthetic_clip;
 #[cfg(test)]
 mod test_util;
 #[cfg(test)]

@@ -39,3 +39,13 @@ pub fn s(p: &Path) -> &str {
 pub fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
+
+/// Writes CMU-style walks that garnet makes itself (`body::pose::synthetic_clip`) into the
+/// mocap folder `root`: each `(clip, frames)`, a path such as `cmu/02/02_01.amc`, with its
+/// subject's skeleton beside it (`cmu/02/02.asf`). Returns `root`.
+pub fn mocap_fixture(root: &Path, clips: &[(&str, usize)]) -> PathBuf {
+    for (clip, frames) in clips {
+        body::pose::synthetic_clip::write_cmu_clip(root, clip, *frames).unwrap();
+    }
+    root.to_path_buf()
+}

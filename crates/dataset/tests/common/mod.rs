@@ -4,7 +4,7 @@
 #![allow(dead_code)]
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::OnceLock;
 
 use body::BodyModel;
@@ -13,6 +13,7 @@ use dataset::{GenerateOptions, GenerateReport, LoadedSpec};
 /// 3 bodies (2 train, 1 test) x (T-shirt in 2 poses + jeans in 1, cut per body), 8 cm
 /// edges, 10 simulator steps: 9 samples in 5 shards of 2.
 pub const FAST: &str = r#"
+format = 2
 name = "fast"
 seed = 3
 shard_size = 2
@@ -54,7 +55,7 @@ pub fn spec(text: &str) -> LoadedSpec {
 
 /// Options with `jobs` threads and no mocap.
 pub fn options(jobs: usize) -> GenerateOptions<'static> {
-    let mut o = GenerateOptions::new(PathBuf::from("/nonexistent-mocap"));
+    let mut o = GenerateOptions::new(None);
     o.jobs = jobs;
     o
 }
