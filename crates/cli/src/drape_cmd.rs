@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use body::BodyModel;
 use clap::Args;
-use garnet::{drape, DrapeOptions, GarmentModel};
+use garnet::{drape, DrapeOptions, FrameRange, GarmentModel};
 use render::palette;
 
 use crate::garment_cmd::garment_color;
@@ -29,10 +29,12 @@ pub struct DrapeArgs {
     #[arg(long)]
     pub keep_pose: bool,
     /// Output mesh of the draped garment (OBJ, PLY or GLB); with several models, the
-    /// garment's kind is added to the name (`draped-tshirt.glb`).
+    /// garment's kind is added to the name (`draped-tshirt.glb`). With --frames: an animated
+    /// GLB of the body and every garment, or a PC2 point cache per garment (`.pc2`, its mesh
+    /// as `.obj` beside it).
     #[arg(long, default_value = "out/draped.glb")]
     pub out: PathBuf,
-    /// Also write the posed body mesh here.
+    /// Also write the posed body mesh here (with --frames: its motion, `.glb` or `.pc2`).
     #[arg(long, value_name = "FILE")]
     pub body_out: Option<PathBuf>,
     /// Picture of the body wearing the garment; with several models, one per garment with
@@ -48,6 +50,20 @@ pub struct DrapeArgs {
     /// cloth (only vertices within 6 cm of the skin are looked at).
     #[arg(long)]
     pub raw: bool,
+    /// Drape a motion: these frames of the clip (--pose-bvh, --pose-amc) or of a procedural
+    /// motion (--pose-procedural, keys every 30 frames), `A..B` or `A..B:STEP` (B exclusive),
+    /// in parallel; the output is an animation.
+    #[arg(long, value_name = "A..B[:STEP]", conflicts_with = "tpose")]
+    pub frames: Option<FrameRange>,
+    /// Frames a second of the animation (default: the clip's rate over the step; 30 for a
+    /// procedural motion).
+    #[arg(long, requires = "frames")]
+    pub fps: Option<f32>,
+    /// Smooth the garments in time (their offsets from the skinned template, filtered over
+    /// five frames); each frame stays within 0.05 cm (mean vertex distance) of its unsmoothed
+    /// drape.
+    #[arg(long, requires = "frames")]
+    pub smooth: bool,
 }
 
 impl DrapeArgs {
@@ -71,12 +87,18 @@ impl DrapeArgs {
             png: Some("out/drape.png".into()),
             device: DeviceArg::Cpu,
             raw: false,
+            frames: None,
+            fps: None,
+            smooth: false,
         })
     }
 }
 
 /// Runs `garnet drape`.
 pub fn run(args: &DrapeArgs) -> anyhow::Result<()> {
+    if let Some(range) = args.frames {
+        return crate::drape_motion::run(args, range);
+    }
     let device = args.device.device()?;
     let body_model = BodyModel::load()?;
     let target = body_model.shape(&args.shape.phenotype(&body_model)?)?;
@@ -141,7 +163,7 @@ pub fn run(args: &DrapeArgs) -> anyhow::Result<()> {
 }
 
 /// `path` with `-KIND` added to its file stem (`out/draped.glb` -> `out/draped-tshirt.glb`).
-fn with_kind(path: &Path, kind: &str) -> PathBuf {
+pub fn with_kind(path: &Path, kind: &str) -> PathBuf {
     let stem = path
         .file_stem()
         .and_then(|s| s.to_str())

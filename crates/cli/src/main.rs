@@ -10,6 +10,7 @@ mod dataset_cmd;
 mod dataset_show;
 mod drape_cmd;
 mod drape_filter_args;
+mod drape_motion;
 mod eval_cmd;
 mod export_cmd;
 mod garment_cmd;

@@ -12,6 +12,7 @@ use dataset::batches::Order;
 /// 3 bodies (train, val, test) x T-shirt in 2 poses: 6 samples of an 8 cm T-shirt, on
 /// bodies skinned by linear blending.
 const SPEC: &str = r#"
+format = 2
 name = "model-cli"
 seed = 4
 shard_size = 2
@@ -244,7 +245,7 @@ fn train_resume_eval_and_drape() {
         err.contains("model.bin") && err.contains(".garnet"),
         "{err}"
     );
-    // Trained on another dataset of the same bodies (as standard-x3 is of standard; here a
+    // Trained on another dataset of the same bodies (as standard-x9-lbs is of standard-lbs; here a
     // folder with this one's manifest, all export reads of it): the card counts that
     // dataset's training drapes and reports the metrics on --data's test split.
     let twin_data = tmp.path().join("twin-data");

@@ -78,22 +78,16 @@ pub struct CutParams {
     pub leg_length: f32,
     /// Extra ease at the limb openings (sleeve cuffs, trouser hems): none up to a quarter of
     /// the way along the sleeve or leg, growing linearly to this at the opening, so the sleeve or
-    /// leg hangs straight instead of following the arm or calf. Absent in files written
-    /// before it existed, where it is 0.
-    #[serde(default)]
+    /// leg hangs straight instead of following the arm or calf.
     pub flare: f32,
     /// How much the cloth spans the body's hollows (the armpits, the gluteal cleft, between
     /// the breasts) instead of following them into the folds, 0 to 1: the share of the
     /// template's bridging smoothing rounds kept (a fraction, not metres). Spanning the
-    /// armpit leaves less cloth there than a raised arm unfolds the skin into. Absent in
-    /// files written before it existed, where it is 1.
-    #[serde(default = "full_bridge")]
+    /// armpit leaves less cloth there than a raised arm unfolds the skin into.
     pub bridge: f32,
     /// Jeans: extra ease over the thighs and knees (a looser thigh, as "relaxed" and
     /// "carrot" cuts have): none at the hips, growing to this [`THIGH_PEAK`] of the way
     /// down the leg (above the knee), none again from `THIGH_PEAK + THIGH_SPAN` (75%) on.
-    /// Absent in files written before it existed, where it is 0.
-    #[serde(default)]
     pub thigh: f32,
 }
 
@@ -103,10 +97,6 @@ pub struct CutParams {
 pub const THIGH_PEAK: f32 = 0.4;
 /// Half the length of the leg (a fraction) over which the `thigh` room spreads.
 pub const THIGH_SPAN: f32 = 0.35;
-
-fn full_bridge() -> f32 {
-    1.0
-}
 
 /// Valid range of each parameter, `(name, min, max)`: metres, except `bridge` (a fraction).
 pub const RANGES: [(&str, f32, f32); 9] = [

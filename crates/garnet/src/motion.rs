@@ -282,3 +282,57 @@ pub fn procedural_motion(
         })
         .collect())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_ranges_parse_and_clip() {
+        let r: FrameRange = "10..20:3".parse().unwrap();
+        assert_eq!(r.frames().collect::<Vec<_>>(), vec![10, 13, 16, 19]);
+        assert_eq!("0..4".parse::<FrameRange>().unwrap().step, 1);
+        for bad in ["4..4", "5..3", "0..9:0", "a..3", "3", "0..x:1"] {
+            assert!(bad.parse::<FrameRange>().is_err(), "{bad}");
+        }
+        assert_eq!(r.within(15).unwrap().frames().last(), Some(13));
+        assert!(r.within(10).is_err());
+    }
+
+    /// Jittered frames over a steady motion: the smoothing lowers the jitter and moves no
+    /// frame more than its bound on average.
+    #[test]
+    fn smoothing_damps_jitter_within_its_bound() {
+        let n = 50;
+        let warped: Vec<Vec<Vec3>> = (0..40)
+            .map(|t| {
+                (0..n)
+                    .map(|j| Vec3::new(j as f32 * 0.01, 0.002 * t as f32, 0.0))
+                    .collect()
+            })
+            .collect();
+        let jitter = |t: usize, j: usize| 0.001 * (((t * 7 + j * 3) % 5) as f32 - 2.0);
+        let frames: Vec<Vec<Vec3>> = warped
+            .iter()
+            .enumerate()
+            .map(|(t, w)| {
+                w.iter()
+                    .enumerate()
+                    .map(|(j, v)| *v + Vec3::Z * jitter(t, j))
+                    .collect()
+            })
+            .collect();
+        let free = smooth_tracks(&frames, &warped, 0.01);
+        assert!(coherence(&free) < 0.6 * coherence(&frames));
+        let within = 0.0002;
+        let bound = smooth_tracks(&frames, &warped, within);
+        assert!(coherence(&bound) < coherence(&frames));
+        for (a, b) in bound.iter().zip(&frames) {
+            let shift = a.iter().zip(b).map(|(p, q)| p.distance(*q)).sum::<f32>() / n as f32;
+            assert!(shift <= within * 1.0001, "{shift}");
+        }
+        // A steady motion has no second difference.
+        assert!(coherence(&warped) < 1e-6);
+        assert_eq!(coherence(&warped[..2]), 0.0);
+    }
+}

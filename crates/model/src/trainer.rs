@@ -213,7 +213,7 @@ impl Trainer {
         self.recipe.as_ref()
     }
 
-    /// Names this run's validation set (say `standard-x3-lbs:tshirt:240`). A best validation
+    /// Names this run's validation set (say `standard-x9-lbs:tshirt:540`). A best validation
     /// E_dist that the checkpoint says was measured on another set does not compare with
     /// this run's: it is cleared, so the next validated epoch writes `best.garnet`, and
     /// returned. Every new best is stored with this name.
