@@ -94,7 +94,7 @@ def test_samples_equal_the_shards_tensors(data):
 
 
 def test_safetensors_package_reads_the_same(data):
-    numpy_st = pytest.importorskip("safetensors.numpy")
+    import safetensors.numpy as numpy_st
     ds = garnet.Dataset(data)
     s = ds[0]
     for shard in (data / "shards").glob("*.safetensors"):
@@ -136,11 +136,14 @@ def test_a_damaged_shard_raises(data, tmp_path):
         ds[0]
 
 
-def test_pytorch_dataloader(data):
-    torch = pytest.importorskip("torch")
+def test_the_dataset_is_a_map_style_sequence(data):
+    """What PyTorch's DataLoader asks of a map-style dataset: len, int indices, IndexError
+    past the end; arrays that wrap the shard's buffer without a copy (torch.from_numpy
+    shares them)."""
     ds = garnet.Dataset(data, split="train")
-    loader = torch.utils.data.DataLoader(ds, batch_size=2)
-    batch = next(iter(loader))
-    assert batch["draped"].dtype == torch.float32 and batch["draped"].shape[0] == min(2, len(ds))
+    assert len(ds) == len(list(iter(ds)))
     s = ds[0]
-    assert torch.from_numpy(s["draped"]).data_ptr() == s["draped"].ctypes.data
+    assert s["draped"].dtype == np.float32 and s["draped"].flags["C_CONTIGUOUS"]
+    assert ds[int(np.int64(0))]["index"] == s["index"]
+    with pytest.raises(IndexError):
+        ds[len(ds)]

@@ -2,6 +2,8 @@
 
 import math
 import shutil
+import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -62,12 +64,25 @@ def test_default_body_and_poses():
         garnet.Pose.procedural(2).rotations
 
 
-def test_clip_poses():
-    amc = REPO.parent / "shared" / "mocap" / "cmu" / "02" / "02_01.amc"
-    if not amc.is_file():
-        pytest.skip(f"no {amc}")
+def synthetic_walk(dir: Path, frames: int) -> Path:
+    """A CMU-style walk garnet writes itself (ASF and AMC) into `dir`; the AMC's path."""
+    subprocess.run(
+        ["cargo", "run", "--release", "-q", "-p", "body", "--example", "synthetic_walk", "--",
+         str(dir), str(frames)],
+        cwd=REPO, check=True, capture_output=True,
+    )
+    return dir / "cmu" / "02" / "02_01.amc"
+
+
+def test_clip_poses(tmp_path, garnet_bin):
+    amc = synthetic_walk(tmp_path, 40)
     body = garnet.Body.random(1, pose=garnet.Pose.from_amc(amc, frame=30))
     assert body.pose.description == "02_01.amc frame 30"
+    bvh = tmp_path / "walk.bvh"
+    run(garnet_bin, "pose", "convert", "--asf", str(amc.with_name("02.asf")), "--amc",
+        str(amc), "--out", str(bvh))
+    from_bvh = garnet.Body.random(1, pose=garnet.Pose.from_bvh(bvh, frame=30))
+    assert from_bvh.vertices.shape == body.vertices.shape
     with pytest.raises(ValueError, match="past the clip"):
         garnet.Pose.from_amc(amc, frame=10**7)
 
