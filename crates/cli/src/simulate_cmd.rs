@@ -27,8 +27,8 @@ pub struct SimulateArgs {
     pub shape: ShapeArgs,
     #[command(flatten)]
     pub pose: PoseArgs,
-    /// How the body is skinned during the animation [default: lbs; with --simulator, the
-    /// file's, dqs if it names none, as for a dataset].
+    /// How the body is skinned during the animation [default: lbs, or the --simulator
+    /// file's].
     #[arg(long, value_enum)]
     pub skinning: Option<SkinningArg>,
     /// The draped garment (.obj, .ply, .glb).
@@ -56,7 +56,7 @@ pub struct SimulateArgs {
     /// Simulator settings: a TOML file with the keys of a dataset spec's `[simulator]`
     /// table (`friction = 0.2`, `stretch_stiffness = 5000.0`, `dt = 0.01`, ...), at its top
     /// level or under a `[simulator]` header, so a dataset spec drapes as its dataset did.
-    /// Keys it leaves out keep their defaults (as in a dataset, `skinning` is `dqs`).
+    /// Keys it leaves out keep the simulator's defaults, as in a dataset.
     #[arg(long, value_name = "FILE.toml")]
     pub simulator: Option<PathBuf>,
     /// Most settling steps after the animation [default: 400, or the --simulator file's].
