@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use anyhow::{anyhow, bail, Context};
 use body::clearance::{clear_limbs, ClearanceOptions};
-use body::{Pose, ShapedBody, Skinning};
+use body::{Pose, RigidTransform, ShapedBody, Skinning};
 use burn::prelude::Device;
 use garment::warp::warp;
 use garment::GarmentTemplate;
@@ -112,6 +112,7 @@ impl Default for DrapeOptions {
 }
 
 /// One draped garment.
+#[derive(Clone, Debug)]
 pub struct DrapedGarment {
     /// The garment kind's name (`tshirt`, `sweater`, `jeans`, or a user garment's name).
     pub kind: String,
@@ -138,6 +139,7 @@ pub struct DrapeTimings {
 }
 
 /// What [`drape`] gives: the posed body and each model's garment on it.
+#[derive(Clone, Debug)]
 pub struct Drape {
     /// The posed body (`[V]` vertices, metres; the body model's faces).
     pub body: TriMesh,
@@ -147,6 +149,37 @@ pub struct Drape {
     pub garments: Vec<DrapedGarment>,
     /// Time to build the body's collider for the push-out (beside the networks), ms.
     pub collider_ms: Option<f64>,
+}
+
+/// A body posed by the caller's own code: its mesh, in garnet's body topology, and where
+/// each bone of garnet's rig went.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PosedBody {
+    /// The posed body's vertices `[V]` (metres), in the body model's vertex order.
+    pub vertices: Vec<glam::Vec3>,
+    /// Each rig bone's posed placement `[B]`, in rig order: its head (metres) and its frame
+    /// (the rotation taking +Y to the bone's head-to-tail direction, with its roll).
+    pub joints: Vec<(glam::Vec3, glam::Quat)>,
+}
+
+impl PosedBody {
+    /// `target` posed in `pose` with `skinning`, as a [`PosedBody`].
+    pub fn from_pose(target: &ShapedBody, pose: &Pose, skinning: Skinning) -> anyhow::Result<Self> {
+        let vertices = target.posed(pose, skinning)?.vertices;
+        let joints = target
+            .rig
+            .skinning_transforms(pose)
+            .iter()
+            .zip(&target.rig.bones)
+            .map(|(s, b)| {
+                (
+                    s.rotation * b.head + s.translation,
+                    (s.rotation * b.frame).normalize(),
+                )
+            })
+            .collect();
+        Ok(PosedBody { vertices, joints })
+    }
 }
 
 /// Drapes every model's garment on `target` (a shaped body in its rest pose) in `pose`.
@@ -166,25 +199,108 @@ pub fn drape(
         pose.clone()
     };
     let body = target.posed(&pose, skinning)?;
+    let warp_m = |m: &GarmentModel| -> anyhow::Result<Vec<glam::Vec3>> {
+        Ok(warp(&m.template, target, &pose, Skinning::Dqs)?.vertices)
+    };
+    let (garments, collider_ms) = drape_on(models, &body, warp_m, opts.push_out)?;
+    Ok(Drape {
+        body,
+        pose,
+        garments,
+        collider_ms,
+    })
+}
+
+/// Drapes every model's garment on a body the caller posed ([`PosedBody`]; posed as the
+/// models' training bodies were, see [`GarmentModel::body_skinning`]): M is each template
+/// skinned by DQS with the bones' placements. No limb clearance (the pose is not known);
+/// the push-out as `push_out` says. Fails on a vertex or bone count that is not the body
+/// model's, a non-finite input, or models that disagree.
+pub fn drape_posed(
+    models: &[GarmentModel],
+    posed: &PosedBody,
+    push_out: bool,
+) -> anyhow::Result<Vec<DrapedGarment>> {
+    shared_skinning(models)?;
+    let body_faces = models[0].draper.setup().body_faces.clone().ok_or_else(|| {
+        anyhow!(
+            "{}: the model carries no body faces",
+            models[0].path.display()
+        )
+    })?;
+    let n_body = models[0].draper.setup().body_sampling.n_body;
+    if posed.vertices.len() != n_body {
+        bail!(
+            "the posed body has {} vertices, the body model {n_body}",
+            posed.vertices.len()
+        );
+    }
+    if let Some(k) = posed.vertices.iter().position(|v| !v.is_finite()) {
+        bail!("the posed body's vertex {k} is not finite");
+    }
+    if let Some(k) = posed
+        .joints
+        .iter()
+        .position(|(h, q)| !h.is_finite() || !q.is_finite() || q.length() < 1e-6)
+    {
+        bail!("the posed body's joint {k} is not finite, or its frame is not a rotation");
+    }
+    let body = TriMesh::new(posed.vertices.clone(), body_faces);
+    let warp_m = |m: &GarmentModel| -> anyhow::Result<Vec<glam::Vec3>> {
+        let rig = &m.template.rig;
+        if posed.joints.len() != rig.bones.len() {
+            bail!(
+                "the posed body has {} joints, the rig {}",
+                posed.joints.len(),
+                rig.bones.len()
+            );
+        }
+        let transforms: Vec<RigidTransform> = rig
+            .bones
+            .iter()
+            .zip(&posed.joints)
+            .map(|(rest, (head, frame))| {
+                let rotation = (frame.normalize() * rest.frame.inverse()).normalize();
+                RigidTransform {
+                    rotation,
+                    translation: *head - rotation * rest.head,
+                }
+            })
+            .collect();
+        let t = &m.template;
+        Ok(t.weights
+            .apply(&t.mesh.vertices, &transforms, Skinning::Dqs))
+    };
+    Ok(drape_on(models, &body, warp_m, push_out)?.0)
+}
+
+/// The networks of `models` on `body` (posed, `[V]`), each with its M from `warp_m`, then
+/// the push-out when asked; the collider's build time (ms) with it.
+fn drape_on(
+    models: &[GarmentModel],
+    body: &TriMesh,
+    warp_m: impl Fn(&GarmentModel) -> anyhow::Result<Vec<glam::Vec3>> + Sync,
+    push_out: bool,
+) -> anyhow::Result<(Vec<DrapedGarment>, Option<f64>)> {
     // The networks first (the body's collider is built beside them), then the push-out.
-    let (predicted, collider) = beside_push_out_collider(opts.push_out.then_some(&body), || {
+    let (predicted, collider) = beside_push_out_collider(push_out.then_some(body), || {
         models
             .iter()
             .map(|m| {
                 let start = Instant::now();
-                let warped = warp(&m.template, target, &pose, Skinning::Dqs)?;
+                let warped = warp_m(m)?;
                 let warp_ms = start.elapsed().as_secs_f64() * 1e3;
                 let start = Instant::now();
                 let draped = m
                     .draper
-                    .drape(&body.vertices, &warped.vertices)
+                    .drape(&body.vertices, &warped)
                     .with_context(|| format!("{}: draping", m.path.display()))?;
                 let timings = DrapeTimings {
                     warp_ms,
                     network_ms: start.elapsed().as_secs_f64() * 1e3,
                     push_out_ms: 0.0,
                 };
-                Ok((draped, warped.vertices, timings))
+                Ok((draped, warped, timings))
             })
             .collect::<anyhow::Result<Vec<_>>>()
     });
@@ -207,12 +323,7 @@ pub fn drape(
             pushed_out,
         });
     }
-    Ok(Drape {
-        body,
-        pose,
-        garments,
-        collider_ms: collider.map(|(_, ms)| ms),
-    })
+    Ok((garments, collider.map(|(_, ms)| ms)))
 }
 
 /// The body skinning `models` share; fails, naming two of them, when they differ.

@@ -33,7 +33,9 @@ pub mod motion;
 pub mod shipped;
 
 pub use burn::prelude::Device;
-pub use drape::{drape, Drape, DrapeOptions, DrapeTimings, DrapedGarment, GarmentModel};
+pub use drape::{
+    drape, drape_posed, Drape, DrapeOptions, DrapeTimings, DrapedGarment, GarmentModel, PosedBody,
+};
 pub use eval::{evaluate, EvalOptions, EvalReport};
 pub use motion::{drape_motion, FrameRange, Motion, MotionOptions};
 pub use shipped::{shipped_models, shipped_models_dir, SHIPPED_MODELS};

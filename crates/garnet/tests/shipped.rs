@@ -78,3 +78,52 @@ fn models_that_learned_from_differently_posed_bodies_are_not_draped_together() {
         .expect("no model");
     assert!(err.to_string().contains("no model"), "{err}");
 }
+
+/// A body the caller posed (mesh and bone placements) drapes as the same body and pose
+/// given by shape and pose; wrong counts and NaN are refused.
+#[test]
+fn a_body_posed_by_the_caller_drapes_as_its_shape_and_pose() {
+    use garnet::body::pose::{PoseKind, ProceduralPoseGenerator};
+    use garnet::{drape_posed, PosedBody};
+    let device = Device::flex();
+    let model =
+        GarmentModel::load(&shipped_models_dir().join("jeans-local.garnet"), &device).unwrap();
+    let bodies = BodyModel::load().unwrap();
+    let target = bodies.shape(&Phenotype::default()).unwrap();
+    let mut walks = ProceduralPoseGenerator::new(5, PoseKind::Walk);
+    let pose = garnet::body::self_contact::sample_valid_pose(&target, &mut walks, 200).unwrap();
+    let opts = DrapeOptions {
+        clear_limbs: false,
+        push_out: true,
+    };
+    let models = [model];
+    let by_pose = drape(&models, &target, &pose, opts).unwrap();
+    let posed = PosedBody::from_pose(&target, &pose, models[0].body_skinning().unwrap()).unwrap();
+    let by_mesh = drape_posed(&models, &posed, true).unwrap();
+    let worst = by_pose.garments[0]
+        .mesh
+        .vertices
+        .iter()
+        .zip(&by_mesh[0].mesh.vertices)
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0f32, f32::max);
+    assert!(worst < 1e-4, "{worst} m");
+    let mut short = posed.clone();
+    short.vertices.pop();
+    assert!(drape_posed(&models, &short, true)
+        .unwrap_err()
+        .to_string()
+        .contains("vertices"));
+    let mut few = posed.clone();
+    few.joints.pop();
+    assert!(drape_posed(&models, &few, true)
+        .unwrap_err()
+        .to_string()
+        .contains("joints"));
+    let mut nan = posed;
+    nan.joints[3].0.x = f32::NAN;
+    assert!(drape_posed(&models, &nan, true)
+        .unwrap_err()
+        .to_string()
+        .contains("joint 3"));
+}
