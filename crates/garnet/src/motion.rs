@@ -267,18 +267,8 @@ pub fn procedural_motion(
     Ok((0..frames)
         .map(|f| {
             let (k, t) = (f / key_every, (f % key_every) as f32 / key_every as f32);
-            let (a, b) = (&keys[k], &keys[k + 1]);
             // Smoothstep: each key is held for an instant, so the motion has no kinks there.
-            let s = t * t * (3.0 - 2.0 * t);
-            Pose {
-                root_translation: a.root_translation.lerp(b.root_translation, s),
-                rotations: a
-                    .rotations
-                    .iter()
-                    .zip(&b.rotations)
-                    .map(|(p, q)| p.slerp(*q, s))
-                    .collect(),
-            }
+            keys[k].slerp(&keys[k + 1], t * t * (3.0 - 2.0 * t))
         })
         .collect())
 }
