@@ -199,10 +199,13 @@ fn valid_fixtures_read() {
     let asf = Asf::read(fixture("mini.asf")).unwrap();
     let amc = Amc::read(fixture("mini.amc"), &asf).unwrap();
     assert_eq!((asf.bones.len(), amc.frame_count()), (4, 2));
-    let clip = Clip::from_bvh(fixture("mini.bvh"), None).unwrap();
-    assert_eq!(clip.frame_count(), 3);
     let bvh = Bvh::read(fixture("mini.bvh"), None).unwrap();
+    assert_eq!(bvh.frame_count(), 3);
     assert!((bvh.metres_per_unit - 0.0254 / 0.45).abs() < 1e-12);
+    // A hip and a leg are no body to pose.
+    let err = Clip::from_bvh(fixture("mini.bvh"), None).unwrap_err();
+    assert!(matches!(err, PoseError::Skeleton { .. }), "{err}");
+    assert!(err.to_string().contains("mini.bvh") && err.to_string().contains("no joint for"));
 }
 
 /// Asserts that reading `name` fails with an error naming the file and `line`.

@@ -1,9 +1,13 @@
-//! Biovision hierarchy files (BVH) as the CMU conversions write them.
+//! Biovision hierarchy files (BVH), read in the file's own axes and joint names
+//! ([`BvhRig`](super::BvhRig) places them on garnet's rig).
 //!
 //! The rest pose is the skeleton of the OFFSETs with every rotation zero. A joint's
 //! rotation channels compose in the order the CHANNELS line lists them (intrinsic, left
-//! to right); its position channels add to its OFFSET. A joint's world rotation rotates
-//! the OFFSETs of its children.
+//! to right). A joint's position channels give its position relative to its parent when
+//! their values lie nearer its OFFSET than zero on average (along the OFFSET: the files
+//! that repeat the OFFSET in six channels per joint, a root whose OFFSET is its rest
+//! position); otherwise they add to the OFFSET. A joint's world rotation rotates the
+//! positions of its children.
 
 use std::path::{Path, PathBuf};
 
@@ -77,6 +81,8 @@ pub struct Bvh {
     /// Values per frame (all joints' channels).
     pub channel_count: usize,
     values: Vec<f64>,
+    /// Whether each joint's position channels replace its OFFSET, `[joints]`.
+    absolute: Vec<bool>,
 }
 
 /// Rest height of a standing adult's joints (toes to top of head), metres, used to detect
@@ -89,7 +95,8 @@ const UNIT_CANDIDATES: [f64; 5] = [1.0, 0.01, 0.001, 0.0254, 0.0254 / 0.45];
 
 impl Bvh {
     /// Reads a BVH file. `metres_per_unit`: the file's length unit in metres, or `None` to
-    /// pick the one (m, cm, mm, inch, CMU unit) that makes the skeleton about 1.6 m tall.
+    /// pick the one (m, cm, mm, inch, CMU unit) that makes the rest skeleton about 1.6 m
+    /// tall along its up axis (feet to head, when the joint names place them; else Y).
     pub fn read(path: impl AsRef<Path>, metres_per_unit: Option<f64>) -> Result<Bvh, PoseError> {
         let path = path.as_ref();
         Self::parse(&read_text(path)?, path, metres_per_unit)
@@ -107,8 +114,10 @@ impl Bvh {
             }
             None => detect_unit(&joints),
         };
+        let absolute = absolute_positions(&joints, &values, channel_count);
         Ok(Bvh {
             path: path.to_path_buf(),
+            absolute,
             joints,
             frame_time,
             metres_per_unit,
@@ -138,7 +147,7 @@ impl Bvh {
         &self.values[f * self.channel_count..(f + 1) * self.channel_count]
     }
 
-    /// Local rotation and translation (file unit, added to the OFFSET) of joint `j` in a
+    /// Local rotation and position-channel translation (file unit) of joint `j` in a
     /// value row.
     fn local(&self, j: usize, row: &[f64]) -> (DQuat, DVec3) {
         let joint = &self.joints[j];
@@ -176,7 +185,12 @@ impl Bvh {
         let mut pos: Vec<DVec3> = Vec::with_capacity(self.joints.len());
         for (j, joint) in self.joints.iter().enumerate() {
             let (q, t) = self.local(j, row);
-            let local_pos = (joint.offset + t) * s;
+            let base = if f.is_some() && self.absolute[j] {
+                DVec3::ZERO
+            } else {
+                joint.offset
+            };
+            let local_pos = (base + t) * s;
             match joint.parent {
                 None => {
                     world.push(q.normalize());
@@ -206,16 +220,41 @@ impl Bvh {
     }
 }
 
-/// Metres per unit that makes the rest skeleton closest (in ratio) to a standing adult.
+/// Whether each joint's position channels replace its OFFSET (see the module
+/// documentation): the mean over frames of `values . OFFSET` exceeds `|OFFSET|^2 / 2`.
+fn absolute_positions(joints: &[BvhJoint], values: &[f64], channel_count: usize) -> Vec<bool> {
+    let frames = values.len() / channel_count.max(1);
+    joints
+        .iter()
+        .map(|j| {
+            let o = j.offset;
+            if frames == 0 || o.length_squared() == 0.0 {
+                return false;
+            }
+            let mut along = 0.0;
+            for row in values.chunks_exact(channel_count) {
+                for (k, c) in j.channels.iter().enumerate() {
+                    if let BvhChannel::Position(a) = c {
+                        along += a.unit().dot(o) * row[j.first_channel + k];
+                    }
+                }
+            }
+            along / frames as f64 > 0.5 * o.length_squared()
+        })
+        .collect()
+}
+
+/// Metres per unit that makes the rest skeleton's extent along its up axis closest (in
+/// ratio) to a standing adult's.
 fn detect_unit(joints: &[BvhJoint]) -> f64 {
-    let mut pos: Vec<DVec3> = Vec::with_capacity(joints.len());
+    let pos = super::bvh_rig::rest_positions(joints);
+    let (bones, _) = super::bvh_rig::assign(joints);
+    let up = super::bvh_rig::rest_up(&bones, &pos).unwrap_or(DVec3::Y);
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for j in joints {
-        let p = j.parent.map_or(DVec3::ZERO, |p| pos[p]) + j.offset;
-        pos.push(p);
-        for q in std::iter::once(p).chain(j.end_site.map(|e| p + e)) {
-            lo = lo.min(q.y);
-            hi = hi.max(q.y);
+    for (j, p) in joints.iter().zip(&pos) {
+        for q in std::iter::once(*p).chain(j.end_site.map(|e| *p + e)) {
+            lo = lo.min(q.dot(up));
+            hi = hi.max(q.dot(up));
         }
     }
     let height = hi - lo;

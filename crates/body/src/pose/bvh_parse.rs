@@ -91,8 +91,17 @@ impl<'a> HierarchyParser<'a, '_> {
     }
 
     fn joint(&mut self, parent: Option<usize>) -> Result<(), PoseError> {
-        let (_, name) = self.next("a joint name")?;
-        let name = name.to_string();
+        // A name runs to the end of its line or a '{' (`JOINT Bip01 L Thigh`).
+        let (ln, first) = self.next("a joint name")?;
+        let mut name = first.to_string();
+        while let Some(&(l, t)) = self.tokens.get(self.at) {
+            if l != ln || t == "{" {
+                break;
+            }
+            name.push(' ');
+            name.push_str(t);
+            self.at += 1;
+        }
         self.expect("{")?;
         let offset = self.offset()?;
         let index = self.joints.len();

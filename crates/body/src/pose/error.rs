@@ -23,6 +23,15 @@ pub enum PoseError {
         /// The underlying error.
         source: std::io::Error,
     },
+    /// A motion file's skeleton cannot be placed on garnet's rig: the file and why (the
+    /// parts it lacks, the joints it could not place).
+    #[error("{}: {message}", path.display())]
+    Skeleton {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
     /// A frame index past the end of a clip.
     #[error("frame {frame} is out of range: the clip has {count} frames")]
     FrameOutOfRange {

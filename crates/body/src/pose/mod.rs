@@ -1,5 +1,5 @@
-//! Pose sources: CMU-style motion files (ASF/AMC and BVH), retargeting onto a shaped
-//! [`Rig`](crate::rig::Rig), and a seeded procedural pose generator.
+//! Pose sources: motion files (CMU ASF/AMC, and BVH of the common rigs), retargeting onto
+//! a shaped [`Rig`](crate::rig::Rig), and a seeded procedural pose generator.
 //!
 //! Units inside are metres and radians; degrees and file length units appear only at file
 //! boundaries. The world is garnet's: Y up, the body facing +Z, its left side at +X.
@@ -10,10 +10,12 @@ mod asf_fk;
 mod asf_parse;
 mod bvh;
 mod bvh_parse;
+mod bvh_rig;
 mod bvh_write;
 pub mod cmu;
 mod error;
 pub mod euler;
+pub mod joint_names;
 pub mod procedural;
 mod retarget;
 mod source;
@@ -32,6 +34,7 @@ pub use amc::Amc;
 pub use asf::{Asf, AsfBone, AsfRoot, AsfUnits, Dof};
 pub use asf_fk::AsfPose;
 pub use bvh::{Bvh, BvhChannel, BvhJoint};
+pub use bvh_rig::BvhRig;
 pub use bvh_write::{bvh_string, save_bvh, BvhWriteOptions};
 pub use error::PoseError;
 pub use procedural::{

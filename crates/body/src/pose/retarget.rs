@@ -5,7 +5,10 @@
 //! rotation relative to its rest, `a_s` its rest direction, `d_b` the rig bone's rest
 //! direction, `O_b` the smallest rotation taking `d_b` to `a_s`, and the rig bone's world
 //! delta is `D_b = G_s * O_b`, so that `D_b d_b = G_s a_s`. The root takes `G_root`
-//! directly; rig bones without a source bone follow their parent.
+//! directly; rig bones without a source bone follow their parent. When the bone that
+//! continues `b`'s chain (`Neck` -> `Neck1`) has no source bone, `d_b` runs from `b`'s
+//! head to the head of the first chain bone below that has one (`Head`), so that `b` and
+//! the bones between, turning together, span the source bone.
 //!
 //! The clavicles and the pelvic hip bones are the exception: their rest directions
 //! reflect where a marker set or a skeleton author put the joints, not a posture (a CMU
@@ -22,9 +25,11 @@ use glam::{DQuat, DVec3, Quat, Vec3};
 use super::amc::Amc;
 use super::asf::Asf;
 use super::bvh::Bvh;
+use super::bvh_rig::{chain_child, BvhRig};
+use super::cmu::{cmu_index, CMU_BONES};
 use super::error::PoseError;
 use super::source::{SourceFrame, SourceSkeleton};
-use crate::rig::{Pose, Rig};
+use crate::rig::{Bone, Pose, Rig};
 
 /// Options of retargeting.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -76,7 +81,7 @@ pub fn retarget_rotations(
             }
             (Some(_), Some(s)) => {
                 let a = skeleton.rest_vectors[s];
-                let d = (bone.tail - bone.head).as_dvec3();
+                let d = rest_span(rig, &by_name, bone).as_dvec3();
                 let g = frame.world[s];
                 if a.length() > 1e-9 && d.length() > 1e-9 {
                     g * DQuat::from_rotation_arc(d.normalize(), a.normalize())
@@ -89,6 +94,29 @@ pub fn retarget_rotations(
         deltas.push(d.normalize().as_quat());
     }
     Ok(deltas)
+}
+
+/// The rest vector a driven rig bone is aligned by: head to tail, or, when the bone that
+/// continues its chain is not driven, head to the head of the first chain bone below that
+/// is (see the module documentation).
+fn rest_span(rig: &Rig, driven: &HashMap<&str, usize>, bone: &Bone) -> Vec3 {
+    let own = bone.tail - bone.head;
+    let Some(b) = cmu_index(&bone.name) else {
+        return own;
+    };
+    let in_rig = |c: usize| rig.index(CMU_BONES[c].name).map(|i| &rig.bones[i]);
+    let mut c = chain_child(b);
+    if c.is_some_and(|c| driven.contains_key(CMU_BONES[c].name)) {
+        return own;
+    }
+    while let Some(ci) = c {
+        let Some(below) = in_rig(ci) else { break };
+        if driven.contains_key(CMU_BONES[ci].name) {
+            return below.head - bone.head;
+        }
+        c = chain_child(ci);
+    }
+    own
 }
 
 /// Hip-to-ankle length of a rig (thigh plus shin, mean of both legs), metres; falls back
@@ -192,8 +220,13 @@ pub enum ClipData {
         /// The motion.
         amc: Box<Amc>,
     },
-    /// A BVH file.
-    Bvh(Box<Bvh>),
+    /// A BVH file and how its skeleton sits on garnet's rig.
+    Bvh {
+        /// The file.
+        bvh: Box<Bvh>,
+        /// Its joints' places on the rig and its axes.
+        rig: Box<BvhRig>,
+    },
 }
 
 /// A motion clip that can pose a rig frame by frame.
@@ -225,16 +258,22 @@ impl Clip {
         })
     }
 
-    /// A clip from a BVH file; `metres_per_unit` as in [`Bvh::read`].
+    /// A clip from a BVH file of any common rig (CMU, Mixamo, 3ds Max biped, generic
+    /// names; any up axis and facing); `metres_per_unit` as in [`Bvh::read`]. A skeleton
+    /// that cannot be placed on garnet's rig is refused (see [`BvhRig::new`]).
     pub fn from_bvh(
         path: impl AsRef<Path>,
         metres_per_unit: Option<f64>,
     ) -> Result<Clip, PoseError> {
         let bvh = Bvh::read(path, metres_per_unit)?;
+        let rig = BvhRig::new(&bvh)?;
         Ok(Clip {
-            skeleton: SourceSkeleton::from_bvh(&bvh),
+            skeleton: rig.skeleton(&bvh),
             frame_rate: bvh.frame_rate(),
-            data: ClipData::Bvh(Box::new(bvh)),
+            data: ClipData::Bvh {
+                bvh: Box::new(bvh),
+                rig: Box::new(rig),
+            },
         })
     }
 
@@ -242,7 +281,7 @@ impl Clip {
     pub fn frame_count(&self) -> usize {
         match &self.data {
             ClipData::AsfAmc { amc, .. } => amc.frame_count(),
-            ClipData::Bvh(b) => b.frame_count(),
+            ClipData::Bvh { bvh, .. } => bvh.frame_count(),
         }
     }
 
@@ -251,19 +290,13 @@ impl Clip {
         self.frame_rate
     }
 
-    /// Frame `frame` (0-based) as world rotations of the source skeleton.
+    /// Frame `frame` (0-based) as world rotations of the source skeleton (garnet's axes).
     pub fn source_frame(&self, frame: usize) -> Result<SourceFrame, PoseError> {
         match &self.data {
             ClipData::AsfAmc { asf, amc } => {
                 Ok(SourceFrame::from_asf(asf, &asf.pose_of(amc, frame)?))
             }
-            ClipData::Bvh(b) => {
-                let (world, pos) = b.pose(Some(frame))?;
-                Ok(SourceFrame {
-                    world,
-                    root_position: pos.first().copied().unwrap_or(DVec3::ZERO),
-                })
-            }
+            ClipData::Bvh { bvh, rig } => rig.frame(bvh, frame),
         }
     }
 

@@ -5,8 +5,7 @@ use glam::{DQuat, DVec3};
 
 use super::asf::Asf;
 use super::asf_fk::AsfPose;
-use super::bvh::Bvh;
-use super::cmu::{canonical_name, rig_name_for_asf};
+use super::cmu::rig_name_for_asf;
 
 /// A motion source's skeleton as the retargeter sees it.
 #[derive(Clone, Debug, PartialEq)]
@@ -29,12 +28,14 @@ pub struct SourceSkeleton {
 pub struct SourceFrame {
     /// World rotation of every source bone relative to its rest, `[S]`.
     pub world: Vec<DQuat>,
-    /// Root position, metres, in the source's world (floor at y = 0).
+    /// Root (pelvis) position, metres, in garnet's axes (Y up, facing +Z).
     pub root_position: DVec3,
 }
 
 impl SourceSkeleton {
-    fn new(
+    /// A skeleton from its bones; the leg length is measured from the `LeftUpLeg`,
+    /// `LeftLeg`, `RightUpLeg` and `RightLeg` rest vectors (the rest root height without them).
+    pub(super) fn new(
         names: Vec<String>,
         rest_vectors: Vec<DVec3>,
         root: usize,
@@ -81,40 +82,6 @@ impl SourceSkeleton {
             .flat_map(|(h, t)| [h.y, t.y])
             .fold(root.y, f64::min);
         Self::new(names, vectors, 0, root.y - lowest)
-    }
-
-    /// The skeleton of a BVH file: one bone per joint, from the joint to its End Site or
-    /// to the mean of its children's OFFSETs (the CMU conversions give all children of a
-    /// joint the same OFFSET).
-    pub fn from_bvh(bvh: &Bvh) -> Self {
-        let s = bvh.metres_per_unit;
-        let names = bvh
-            .joints
-            .iter()
-            .map(|j| canonical_name(&j.name).to_string())
-            .collect();
-        let vectors = bvh
-            .joints
-            .iter()
-            .enumerate()
-            .map(|(i, j)| {
-                let v = j.end_site.unwrap_or_else(|| {
-                    let kids: Vec<DVec3> = bvh
-                        .joints
-                        .iter()
-                        .filter(|c| c.parent == Some(i))
-                        .map(|c| c.offset)
-                        .collect();
-                    kids.iter().sum::<DVec3>() / (kids.len().max(1) as f64)
-                });
-                v * s
-            })
-            .collect();
-        let (world, pos) = bvh.pose(None).unwrap_or_default();
-        let ends = bvh.end_sites(&world, &pos);
-        let root_y = pos.first().map_or(0.0, |p| p.y);
-        let lowest = pos.iter().chain(&ends).map(|p| p.y).fold(root_y, f64::min);
-        Self::new(names, vectors, 0, root_y - lowest)
     }
 }
 

@@ -173,3 +173,29 @@ fn written_bvh_reproduces_the_asf_clip() {
     };
     assert!(bvh_string(&asf, &amc, &opts).is_err());
 }
+
+#[test]
+fn names_with_spaces_and_position_channels_that_repeat_the_offset() {
+    // A 3ds Max style name, and a joint whose position channels repeat its OFFSET (read as
+    // its position, not added to it) in frame 0 and move it in frame 1.
+    let text = TWO_JOINTS
+        .replace("JOINT LeftUpLeg", "JOINT Bip01 L Thigh")
+        .replace(
+            "CHANNELS 3 Xrotation Yrotation Zrotation",
+            "CHANNELS 6 Xposition Yposition Zposition Xrotation Yrotation Zrotation",
+        )
+        .replace("0 90 0 0 0 0 0 0 0\n", "0 90 0 0 0 0 10 0 0 0 0 0\n")
+        .replace("1 90 2 90 0 0 30 40 50", "0 90 0 0 0 0 12 0 0 0 0 0");
+    let bvh = Bvh::parse(&text, Path::new("t.bvh"), Some(0.01)).unwrap();
+    assert_eq!(bvh.joints[1].name, "Bip01 L Thigh");
+    let x = |f| bvh.pose(f).unwrap().1[1].x;
+    assert!((x(None) - 0.1).abs() < 1e-12);
+    assert!((x(Some(0)) - 0.1).abs() < 1e-12);
+    assert!((x(Some(1)) - 0.12).abs() < 1e-12);
+    // Position channels near zero add to the OFFSET.
+    let added = text
+        .replace(" 10 0 0 0 0 0\n", " 0 0 0 0 0 0\n")
+        .replace(" 12 0 0", " 2 0 0");
+    let bvh = Bvh::parse(&added, Path::new("t.bvh"), Some(0.01)).unwrap();
+    assert!((bvh.pose(Some(1)).unwrap().1[1].x - 0.12).abs() < 1e-12);
+}
