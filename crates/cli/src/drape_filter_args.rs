@@ -16,7 +16,7 @@ pub struct DrapeFilterArgs {
     #[arg(long, value_name = "PCT")]
     pub max_strain: Option<f32>,
     /// Use only drapes whose garment slid at most this far on the body, cm (simulator
-    /// statistics; drapes made before it was recorded are kept).
+    /// statistics).
     #[arg(long, value_name = "CM")]
     pub max_slide: Option<f32>,
 }

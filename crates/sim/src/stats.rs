@@ -31,14 +31,12 @@ pub struct DrapeStats {
     /// Whether the kinetic energy fell below the rest threshold before the step budget.
     pub converged: bool,
     /// The largest turn of a limb joint by the clearance correction of the pose, degrees.
-    #[serde(default)]
     pub limb_turn_deg: f32,
     /// Walks of garment vertices out of the body the shortest way: vertices found inside
     /// with no way out through their closest surface (caught between overlapping body
     /// parts or under a fold of skin), by the walks while settling
     /// ([`crate::ClothSim::walk_out_of`]) and the exact pass after the last step (a vertex
     /// caught again counts again). Each can leave a spike in the cloth.
-    #[serde(default)]
     pub walked_out: u32,
     /// How far the garment slid on the body: the mean distance, metres, between its
     /// vertices and where the template's surface anchors put them on the final body (the
@@ -46,7 +44,6 @@ pub struct DrapeStats {
     /// about its ease as it settles onto the body (4 cm for the T-shirt at rest on its own
     /// body); one that slid down or off the body (jeans pulled below the hips) shows twice
     /// that or more (17 cm).
-    #[serde(default)]
     pub slid_m: f32,
     /// 90th percentile of the stretch of the body's skin under the garment: over the body
     /// edges of the faces the garment touches (a vertex within [`SKIN_TOUCH_M`]), the
@@ -54,13 +51,11 @@ pub struct DrapeStats {
     /// with the skin or slides. On the 1 cm sheet the drapes that fail (not at
     /// rest, or strain p99 over 2%) are, per garment, exactly those with the most stretched
     /// skin: tops 22.8-38.3% against at most 20.1%, jeans 5.3-15.6% against at most 4.0%.
-    #[serde(default)]
     pub skin_stretch_p90: f32,
     /// 99th percentile of the strain of the garment's elastic edges (its waistband, see
     /// [`crate::waistband`]) against their own rest lengths: how far the elastic is
     /// stretched. The strain fields above are over the cloth's other edges. 0 for a
     /// garment without elastic.
-    #[serde(default)]
     pub elastic_strain_p99: f32,
 }
 
