@@ -1,5 +1,6 @@
 //! `garnet eval`: trained models on a dataset split, as the paper reports them
-//! ([`garnet::eval`]): results.md (printed too), results.json and two precision charts.
+//! ([`garnet::eval`]): results.md (printed too), results.json and two precision charts; with
+//! `--html`, results.html too ([`crate::view_cmd::write_eval_page`]).
 
 use std::path::PathBuf;
 
@@ -44,6 +45,11 @@ pub struct EvalArgs {
     /// repeat).
     #[arg(long, value_name = "DIR")]
     pub save_drapes: Option<PathBuf>,
+    /// Also write the report as a self-contained HTML page, `results.html` in the output
+    /// folder: the tables, the precision charts and, with `--save-drapes`, each model's worst
+    /// three drapes in 3D, coloured by each vertex's distance to the simulator's drape.
+    #[arg(long)]
+    pub html: bool,
 }
 
 /// Runs `garnet eval`.
@@ -63,6 +69,13 @@ pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
     )?;
     report.write(&args.out)?;
     print!("{}", report.markdown());
+    if args.html {
+        let saved = args
+            .save_drapes
+            .as_ref()
+            .map(|root| garnet::eval::save::save_folders(root, &args.models));
+        crate::view_cmd::write_eval_page(&args.out, saved.as_deref())?;
+    }
     eprintln!("wrote {}", args.out.display());
     Ok(())
 }

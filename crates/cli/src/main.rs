@@ -24,6 +24,7 @@ mod shape_args;
 mod simulate_cmd;
 mod simulate_sheet;
 mod train_cmd;
+mod view_cmd;
 
 use clap::{Parser, Subcommand};
 
@@ -70,6 +71,8 @@ enum Cmd {
     /// Benchmarks measured in one run, reported with ratios to a reference.
     #[command(subcommand)]
     Bench(bench_cmd::BenchCmd),
+    /// Meshes, animations and evaluated drapes in 3D: one self-contained HTML page (offline).
+    View(view_cmd::ViewArgs),
 }
 
 fn main() {
@@ -88,6 +91,7 @@ fn main() {
         Some(Cmd::Compare(a)) => compare_cmd::run(a),
         Some(Cmd::Train(a)) => train_cmd::run(a),
         Some(Cmd::Bench(c)) => bench_cmd::run(c),
+        Some(Cmd::View(a)) => view_cmd::run(a),
     };
     if let Err(e) = result {
         eprintln!("garnet: error: {e:#}");

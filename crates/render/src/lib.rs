@@ -12,12 +12,14 @@
 //! - [`Image`]: an RGB picture with atomic PNG writing ([`Image::save_png`]) and reading.
 //! - [`Sheet`]: many pictures in a captioned grid; [`draw_text`] for labels.
 //! - [`palette`]: garment and skin colours, the [`palette::heat`] colour ramp and a legend bar.
+//! - [`page`]: self-contained HTML pages with a 3D view of GLB meshes (three.js embedded).
 
 mod camera;
 mod error;
 mod image;
 mod mesh;
 mod occlusion;
+pub mod page;
 pub mod palette;
 pub mod plot;
 mod raster;

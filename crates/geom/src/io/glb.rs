@@ -58,6 +58,45 @@ fn push_vec3s(bin: &mut Vec<u8>, vs: impl Iterator<Item = Vec3>) {
 /// Encodes meshes as a GLB byte vector. Fails when the list is empty, a mesh has no face, does
 /// not validate, or a colour component is outside [0, 1].
 pub fn encode_glb(meshes: &[GlbMesh]) -> Result<Vec<u8>> {
+    encode(meshes, &[])
+}
+
+/// Encodes meshes as [`encode_glb`] does, each with optional per-vertex colours: where
+/// `colors[i]` is `Some`, mesh `i` gets a `COLOR_0` attribute (float RGB, linear, one per
+/// vertex, each in [0, 1]; glTF multiplies them with the base colour, so heat maps take a
+/// white one). `colors` may be shorter than `meshes` (the rest get none). Fails as
+/// [`encode_glb`] does, and when a colour list's length is not the mesh's vertex count or a
+/// component is outside [0, 1].
+pub fn encode_glb_colored(meshes: &[GlbMesh], colors: &[Option<&[[f32; 3]]>]) -> Result<Vec<u8>> {
+    if colors.len() > meshes.len() {
+        return Err(GeomError::InvalidInput(format!(
+            "GLB: {} colour lists for {} meshes",
+            colors.len(),
+            meshes.len()
+        )));
+    }
+    for (i, (m, c)) in meshes.iter().zip(colors).enumerate() {
+        let Some(c) = c else { continue };
+        if c.len() != m.mesh.vertices.len() {
+            return Err(GeomError::InvalidInput(format!(
+                "GLB mesh {i} ({}): {} vertex colours for {} vertices",
+                m.name,
+                c.len(),
+                m.mesh.vertices.len()
+            )));
+        }
+        if c.as_flattened().iter().any(|v| !(0.0..=1.0).contains(v)) {
+            return Err(GeomError::InvalidInput(format!(
+                "GLB mesh {i} ({}): a vertex colour outside [0, 1]",
+                m.name
+            )));
+        }
+    }
+    encode(meshes, colors)
+}
+
+/// [`encode_glb`] with the optional vertex colours of [`encode_glb_colored`] (checked there).
+fn encode(meshes: &[GlbMesh], colors: &[Option<&[[f32; 3]]>]) -> Result<Vec<u8>> {
     if meshes.is_empty() {
         return Err(GeomError::InvalidInput(
             "GLB needs at least one mesh".into(),
@@ -123,8 +162,22 @@ pub fn encode_glb(meshes: &[GlbMesh]) -> Result<Vec<u8>> {
             json!({"bufferView": base + 2, "componentType": UNSIGNED_INT,
                               "count": 3 * mesh.faces.len(), "type": "SCALAR"}),
         );
+        let mut attributes = json!({"POSITION": base, "NORMAL": base + 1});
+        if let Some(Some(c)) = colors.get(i) {
+            let off = bin.len();
+            for &v in c.as_flattened() {
+                bin.extend_from_slice(&v.to_le_bytes());
+            }
+            views.push(json!({"buffer": 0, "byteOffset": off, "byteLength": 12 * n,
+                              "target": ARRAY_BUFFER}));
+            attributes["COLOR_0"] = json!(accessors.len());
+            accessors.push(
+                json!({"bufferView": views.len() - 1, "componentType": FLOAT,
+                                  "count": n, "type": "VEC3"}),
+            );
+        }
         gmeshes.push(json!({"name": m.name, "primitives": [{
-            "attributes": {"POSITION": base, "NORMAL": base + 1},
+            "attributes": attributes,
             "indices": base + 2, "material": i, "mode": TRIANGLES}]}));
         materials.push(
             json!({"name": m.name, "doubleSided": true, "pbrMetallicRoughness": {
@@ -221,6 +274,38 @@ mod tests {
         }
         let bin_hdr = 20 + jlen;
         assert_eq!(&bytes[bin_hdr + 4..bin_hdr + 8], b"BIN\0");
+    }
+
+    #[test]
+    fn vertex_colours_add_color_0_and_leave_the_rest_alike() {
+        let (s, g, plain) = two_mesh_fixture();
+        let meshes = [
+            GlbMesh {
+                mesh: &s,
+                name: "sphere",
+                color: [1.0, 0.0, 0.0, 1.0],
+            },
+            GlbMesh {
+                mesh: &g,
+                name: "sheet",
+                color: DEFAULT_COLOR,
+            },
+        ];
+        assert_eq!(encode_glb_colored(&meshes, &[]).unwrap(), plain);
+        let colors = vec![[0.25, 0.5, 1.0]; g.vertices.len()];
+        let bytes = encode_glb_colored(&meshes, &[None, Some(&colors)]).unwrap();
+        let prims = super::super::parse_glb(&bytes, Path::new("c.glb")).unwrap();
+        assert_eq!(prims.len(), 2);
+        let jlen = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+        let doc: Value = serde_json::from_slice(&bytes[20..20 + jlen]).unwrap();
+        let attrs = &doc["meshes"][1]["primitives"][0]["attributes"];
+        let acc = &doc["accessors"][attrs["COLOR_0"].as_u64().unwrap() as usize];
+        assert_eq!(acc["count"].as_u64().unwrap() as usize, g.vertices.len());
+        assert!(doc["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"].is_null());
+        let short = vec![[0.0; 3]; 2];
+        assert!(encode_glb_colored(&meshes, &[Some(&short)]).is_err());
+        let bad = vec![[2.0, 0.0, 0.0]; s.vertices.len()];
+        assert!(encode_glb_colored(&meshes, &[Some(&bad)]).is_err());
     }
 
     #[test]

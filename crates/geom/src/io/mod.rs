@@ -19,7 +19,7 @@ pub use anim::{
     AnimatedMesh, PointCache,
 };
 pub use atomic::{write_atomic, write_bytes_atomic};
-pub use glb::{encode_glb, write_glb, GlbMesh, DEFAULT_COLOR};
+pub use glb::{encode_glb, encode_glb_colored, write_glb, GlbMesh, DEFAULT_COLOR};
 pub use glb_read::{parse_glb, read_glb, read_glb_merged, GlbPrimitive};
 pub use obj::{parse_obj, read_obj, read_obj_data, write_obj, write_obj_data, ObjData, ObjGroup};
 pub use ply::{encode_ply, parse_ply, read_ply, write_ply};
