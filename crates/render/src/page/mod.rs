@@ -1,6 +1,6 @@
 //! Self-contained HTML pages that show meshes in 3D in a browser (`garnet view`, `garnet eval
 //! --html`): three.js, its orbit controls and glTF loader are embedded in the binary (vendored
-//! from npm into `crates/render/web/vendor/`, minified) and inlined into every page as `data:`
+//! from npm into `web/vendor/` at the repository root, minified) and inlined into every page as `data:`
 //! URLs of an import map, and the meshes as base64 GLB. A page fetches nothing: it opens from
 //! disk, offline.
 //!
@@ -21,34 +21,34 @@ use serde_json::json;
 use crate::palette;
 
 /// The three.js release the pages embed.
-pub const THREE_VERSION: &str = include_str!("../../web/vendor/three/VERSION");
-const THREE_LICENSE: &str = include_str!("../../web/vendor/three/LICENSE");
+pub const THREE_VERSION: &str = include_str!("../../../../web/vendor/three/VERSION");
+const THREE_LICENSE: &str = include_str!("../../../../web/vendor/three/LICENSE");
 
 /// The import map's modules: bare name and minified source.
 const MODULES: [(&str, &str); 6] = [
     (
         "three/core",
-        include_str!("../../web/vendor/three/build/three.core.min.js"),
+        include_str!("../../../../web/vendor/three/build/three.core.min.js"),
     ),
     (
         "three",
-        include_str!("../../web/vendor/three/build/three.module.min.js"),
+        include_str!("../../../../web/vendor/three/build/three.module.min.js"),
     ),
     (
         "three/addons/controls/OrbitControls.js",
-        include_str!("../../web/vendor/three/examples/jsm/controls/OrbitControls.js"),
+        include_str!("../../../../web/vendor/three/examples/jsm/controls/OrbitControls.js"),
     ),
     (
         "three/addons/loaders/GLTFLoader.js",
-        include_str!("../../web/vendor/three/examples/jsm/loaders/GLTFLoader.js"),
+        include_str!("../../../../web/vendor/three/examples/jsm/loaders/GLTFLoader.js"),
     ),
     (
         "three/addons/utils/BufferGeometryUtils.js",
-        include_str!("../../web/vendor/three/examples/jsm/utils/BufferGeometryUtils.js"),
+        include_str!("../../../../web/vendor/three/examples/jsm/utils/BufferGeometryUtils.js"),
     ),
     (
         "three/addons/utils/SkeletonUtils.js",
-        include_str!("../../web/vendor/three/examples/jsm/utils/SkeletonUtils.js"),
+        include_str!("../../../../web/vendor/three/examples/jsm/utils/SkeletonUtils.js"),
     ),
 ];
 
