@@ -363,7 +363,7 @@ pub fn parse_pc2(bytes: &[u8], path: &Path) -> Result<PointCache> {
 /// Reads a PC2 file.
 pub fn read_pc2(path: impl AsRef<Path>) -> Result<PointCache> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|e| GeomError::format(path, &e.to_string()))?;
+    let bytes = std::fs::read(path).map_err(|e| GeomError::format(path, e.to_string()))?;
     parse_pc2(&bytes, path)
 }
 
