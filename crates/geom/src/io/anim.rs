@@ -17,7 +17,7 @@ use glam::Vec3;
 use serde_json::json;
 
 use super::atomic::write_atomic;
-use super::glb::assemble;
+use super::glb::{assemble, exact, ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, FLOAT, UNSIGNED_INT};
 use crate::error::{GeomError, Result};
 use crate::mesh::TriMesh;
 
@@ -35,16 +35,6 @@ pub struct AnimatedMesh<'a> {
     /// Also animate the normals (morph targets with `NORMAL` changes): exact shading in every
     /// frame, at twice the size.
     pub normals: bool,
-}
-
-const ARRAY_BUFFER: u32 = 34962;
-const ELEMENT_ARRAY_BUFFER: u32 = 34963;
-const FLOAT: u32 = 5126;
-const UNSIGNED_INT: u32 = 5125;
-
-/// The f32 components as f64, so that the JSON holds their exact values.
-fn exact(v: Vec3) -> [f64; 3] {
-    v.as_dvec3().to_array()
 }
 
 /// Appends `words` (4-byte values, little endian) to `bin` and returns the index of the

@@ -35,15 +35,15 @@ pub struct GlbMesh<'a> {
     pub color: [f32; 4],
 }
 
-const ARRAY_BUFFER: u32 = 34962;
-const ELEMENT_ARRAY_BUFFER: u32 = 34963;
-const FLOAT: u32 = 5126;
-const UNSIGNED_INT: u32 = 5125;
+pub(crate) const ARRAY_BUFFER: u32 = 34962;
+pub(crate) const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+pub(crate) const FLOAT: u32 = 5126;
+pub(crate) const UNSIGNED_INT: u32 = 5125;
 const TRIANGLES: u32 = 4;
 
 /// The f32 components as f64 so the JSON holds their exact values: validators compare
 /// accessor min/max with the data read as doubles.
-fn exact(v: Vec3) -> [f64; 3] {
+pub(crate) fn exact(v: Vec3) -> [f64; 3] {
     v.as_dvec3().to_array()
 }
 
@@ -234,20 +234,25 @@ pub fn write_glb(path: impl AsRef<Path>, meshes: &[GlbMesh]) -> Result<()> {
 pub(crate) fn two_mesh_fixture() -> (TriMesh, TriMesh, Vec<u8>) {
     let s = TriMesh::icosphere(1, 0.5);
     let g = TriMesh::grid(3, 2, 0.1);
-    let bytes = encode_glb(&[
+    let bytes = encode_glb(&fixture_meshes(&s, &g)).unwrap();
+    (s, g, bytes)
+}
+
+/// The fixture's two meshes: `s` red, `g` in the default colour.
+#[cfg(test)]
+fn fixture_meshes<'a>(s: &'a TriMesh, g: &'a TriMesh) -> [GlbMesh<'a>; 2] {
+    [
         GlbMesh {
-            mesh: &s,
+            mesh: s,
             name: "sphere",
             color: [1.0, 0.0, 0.0, 1.0],
         },
         GlbMesh {
-            mesh: &g,
+            mesh: g,
             name: "sheet",
             color: DEFAULT_COLOR,
         },
-    ])
-    .unwrap();
-    (s, g, bytes)
+    ]
 }
 
 #[cfg(test)]
@@ -279,18 +284,7 @@ mod tests {
     #[test]
     fn vertex_colours_add_color_0_and_leave_the_rest_alike() {
         let (s, g, plain) = two_mesh_fixture();
-        let meshes = [
-            GlbMesh {
-                mesh: &s,
-                name: "sphere",
-                color: [1.0, 0.0, 0.0, 1.0],
-            },
-            GlbMesh {
-                mesh: &g,
-                name: "sheet",
-                color: DEFAULT_COLOR,
-            },
-        ];
+        let meshes = fixture_meshes(&s, &g);
         assert_eq!(encode_glb_colored(&meshes, &[]).unwrap(), plain);
         let colors = vec![[0.25, 0.5, 1.0]; g.vertices.len()];
         let bytes = encode_glb_colored(&meshes, &[None, Some(&colors)]).unwrap();
