@@ -35,6 +35,9 @@ fn shipped_models() -> PyResult<Vec<std::path::PathBuf>> {
 
 #[pymodule]
 fn _garnet(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // The package drapes in this process: malloc tuned for the networks' large temporaries
+    // (see model::alloc), once, when it is imported.
+    garnet::model::tune_allocator();
     m.add("GarnetError", m.py().get_type::<GarnetError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<body::Pose>()?;

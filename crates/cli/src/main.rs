@@ -76,6 +76,8 @@ enum Cmd {
 }
 
 fn main() {
+    // Process-wide malloc tuning for the networks' large temporaries (see model::alloc).
+    model::tune_allocator();
     let cli = Cli::parse();
     let result = match &cli.cmd {
         None => drape_cmd::DrapeArgs::main_job().and_then(|a| drape_cmd::run(&a)),

@@ -12,6 +12,8 @@ use garnet::body::BodyModel;
 use garnet::{drape, shipped_models_dir, Device, DrapeOptions, GarmentModel};
 
 fn main() -> anyhow::Result<()> {
+    // Process-wide malloc tuning for the networks' large temporaries (see model::alloc).
+    garnet::model::tune_allocator();
     // The body: a random adult (seed 7) in a procedural walking pose (seed 3).
     let bodies = BodyModel::load()?;
     let shape = ShapeDistribution::default().sample(&bodies, 7)?;

@@ -13,6 +13,8 @@ use std::path::PathBuf;
 use garnet::{evaluate, shipped_models, Device, EvalOptions};
 
 fn main() -> anyhow::Result<()> {
+    // Process-wide malloc tuning for the networks' large temporaries (see model::alloc).
+    garnet::model::tune_allocator();
     let mut args = std::env::args().skip(1);
     let (mut data, mut models, mut out) = (None, Vec::new(), PathBuf::from("out/example-eval"));
     while let Some(a) = args.next() {

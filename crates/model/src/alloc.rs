@@ -8,8 +8,10 @@
 //! [`tune_allocator`] raises the mmap threshold to glibc's maximum (32 MB) and the trim
 //! threshold to 512 MB, so that freed blocks are reused instead of returned to the system.
 //! The cost is that the process keeps up to its peak heap (hundreds of MB while training on
-//! 10k-vertex garments). [`crate::Draper`] and [`crate::Trainer`] call it when they are made;
-//! a program with another global allocator (mimalloc, jemalloc) is not affected.
+//! 10k-vertex garments). It changes the whole process's allocator, so the libraries never
+//! call it: a program calls it once at its start (the `garnet` binary does, as do the Python
+//! package and the library's examples); a program with another global allocator (mimalloc,
+//! jemalloc) is not affected.
 
 use std::sync::OnceLock;
 

@@ -35,10 +35,9 @@ impl std::fmt::Debug for Draper {
 
 impl Draper {
     /// Wraps `model` with its `setup`, on `device` (the model is moved there, without
-    /// autodiff). Fails when the model and the setup disagree. Tunes the allocator (see
-    /// [`crate::alloc`]).
+    /// autodiff). Fails when the model and the setup disagree. A program that drapes on the
+    /// CPU is faster with [`crate::tune_allocator`] called once at its start.
     pub fn new(model: GarNet, setup: ModelSetup, device: &Device) -> Result<Draper> {
-        crate::alloc::tune_allocator();
         let device = device.clone().inner();
         if model.variant() != setup.config.variant {
             return Err(ModelError::InvalidInput(format!(

@@ -76,7 +76,8 @@ pub struct EpochReport {
 }
 
 /// Trains one network: holds it (on an autodiff device), its Adam optimiser, its setup and
-/// progress. Making one tunes the allocator (see [`crate::alloc`]).
+/// progress. A training program is faster with [`crate::tune_allocator`] called once at
+/// its start.
 pub struct Trainer {
     model: GarNet,
     optim: ModuleOptimizer,
@@ -156,7 +157,6 @@ impl Trainer {
         lr: f64,
         device: Device,
     ) -> Result<Trainer> {
-        crate::alloc::tune_allocator();
         loss.validate()?;
         if !(lr.is_finite() && lr > 0.0) {
             return Err(ModelError::InvalidInput(format!(
