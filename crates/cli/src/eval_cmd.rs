@@ -39,6 +39,11 @@ pub struct EvalArgs {
     /// out" (the paper's Table 1 has the network's raw output only).
     #[arg(long)]
     pub push_out: bool,
+    /// Also a row per garment of the surface-anchored warp: the template carried onto each
+    /// body's rest shape by its surface anchors (as the simulator grades it), then skinned
+    /// as the dataset's bodies are; a baseline beside DQS.
+    #[arg(long)]
+    pub fitted: bool,
     /// Also write every evaluated drape (the network's, the simulator's, the warped M and
     /// the body, PLY in metres) and a table of each drape's errors, `samples.csv`, into
     /// `DIR/MODEL/` for each model file `MODEL.garnet` (`DIR/PARENT-MODEL/` where file names
@@ -58,6 +63,7 @@ pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
         filter: args.drapes.filter()?,
         max_samples: args.max_samples,
         push_out: args.push_out,
+        fitted: args.fitted,
         save_drapes: args.save_drapes.clone(),
     };
     let report = garnet::evaluate(

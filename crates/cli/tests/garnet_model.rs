@@ -171,6 +171,7 @@ fn train_resume_eval_and_drape() {
         "--out",
         s(&eval),
         "--push-out",
+        "--fitted",
         "--save-drapes",
         s(&eval.join("drapes")),
     ]);
@@ -179,6 +180,7 @@ fn train_resume_eval_and_drape() {
         "| tshirt | GarNet-local, pushed out |",
         "GarNet-naive",
         "| tshirt | DQS |",
+        "| tshirt | surface-anchored warp |",
         "simulator / network",
         "## E_dist by motion",
         "| tshirt | GarNet-local | procedural walk |",

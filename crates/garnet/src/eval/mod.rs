@@ -32,6 +32,10 @@ use save::{save_folders, DrapeSaver, SavedDrape};
 pub struct EvalOutputs<'a> {
     /// Also the network's drapes pushed out of the body as `garnet drape` does.
     pub push_out: bool,
+    /// Also a row of the surface-anchored warp (`garment::warp::warp_fitted`: the template
+    /// carried onto the target's rest shape by its surface anchors, then skinned as the
+    /// dataset's bodies are): the base the simulator grades its garments by, as a baseline.
+    pub fitted: bool,
     /// Write every drape and its errors into this folder (see [`save`]).
     pub save_drapes: Option<&'a Path>,
 }
@@ -167,6 +171,8 @@ pub struct ModelEvaluation {
     /// The network's drapes pushed out of the body as `garnet drape` does, when asked.
     pushed: Option<Row>,
     dqs: Row,
+    /// The surface-anchored warp of the same samples, when asked.
+    fitted: Option<Row>,
     timing: Timing,
     by_motion: Vec<MotionRow>,
 }
@@ -219,6 +225,7 @@ pub struct EvalData {
     data: Dataset,
     body_faces: Vec<[u32; 3]>,
     body_rest: body::ShapedBody,
+    body_model: BodyModel,
     sim_times: HashMap<u64, f64>,
 }
 
@@ -227,7 +234,8 @@ impl EvalData {
     pub fn open(dir: &Path) -> anyhow::Result<Self> {
         let data = Dataset::open(dir)?;
         let body_faces = data.body_faces()?;
-        let body_rest = BodyModel::load()?.shape(&Phenotype::default())?;
+        let body_model = BodyModel::load()?;
+        let body_rest = body_model.shape(&Phenotype::default())?;
         let sim_times = data
             .manifest()
             .samples
@@ -238,6 +246,7 @@ impl EvalData {
             data,
             body_faces,
             body_rest,
+            body_model,
             sim_times,
         })
     }
@@ -288,8 +297,17 @@ impl EvalData {
             path.display(),
             indices.len()
         );
-        let (mut net, mut pushed, mut dqs) =
-            (Errors::default(), Errors::default(), Errors::default());
+        let (mut net, mut pushed, mut dqs, mut fitted) = (
+            Errors::default(),
+            Errors::default(),
+            Errors::default(),
+            Errors::default(),
+        );
+        let anchors = outputs
+            .fitted
+            .then(|| garment::warp::SurfaceAnchors::new(&template.mesh, &self.body_rest.mesh))
+            .transpose()?;
+        let skinning = data.body_skinning();
         let mut by_motion = ByMotion::default();
         let mut saver = outputs
             .save_drapes
@@ -332,6 +350,14 @@ impl EvalData {
                 };
                 let net_cm = net.add(&a.draped, &pred, faces, body)?;
                 let dqs_cm = dqs.add(&a.draped, &a.warped, faces, body)?;
+                if let Some(anchors) = &anchors {
+                    let target = self
+                        .body_model
+                        .shape(&Phenotype::from_values(&a.phenotype)?)?;
+                    let m =
+                        garment::warp::warp_fitted(&template, anchors, &target, &pose, skinning)?;
+                    fitted.add(&a.draped, &m.vertices, faces, body)?;
+                }
                 if let Some(saver) = &mut saver {
                     saver.save(&SavedDrape {
                         index: s.record.index,
@@ -359,6 +385,9 @@ impl EvalData {
             net: net.row(&garment, &method),
             pushed: push_out.then(|| pushed.row(&garment, &format!("{method}, pushed out"))),
             dqs: dqs.row(&garment, "DQS"),
+            fitted: outputs
+                .fitted
+                .then(|| fitted.row(&garment, "surface-anchored warp")),
             timing: Timing {
                 garment: garment.clone(),
                 method,
@@ -392,6 +421,8 @@ pub struct EvalOptions {
     pub max_samples: Option<usize>,
     /// Also rows of each network's drapes after the push-out (`garnet drape`'s default).
     pub push_out: bool,
+    /// Also a row per garment of the surface-anchored warp (see [`EvalOutputs::fitted`]).
+    pub fitted: bool,
     /// Also write every evaluated drape and its errors under this folder, one folder per
     /// model (see [`save`]).
     pub save_drapes: Option<PathBuf>,
@@ -420,6 +451,7 @@ pub fn evaluate(
             opts.max_samples,
             EvalOutputs {
                 push_out: opts.push_out,
+                fitted: opts.fitted,
                 save_drapes: save_dirs.as_ref().map(|d| d[i].as_path()),
             },
             device,
@@ -440,6 +472,7 @@ pub fn evaluate(
         report.rows.extend(e.pushed);
         if dqs_done.insert(e.garment) {
             report.rows.push(e.dqs);
+            report.rows.extend(e.fitted);
         }
         report.timings.push(e.timing);
         report.motions.extend(e.by_motion);
