@@ -326,10 +326,13 @@ pub fn parse_pc2(bytes: &[u8], path: &Path) -> Result<PointCache> {
         return Err(bad("PC2 point or sample count is not positive"));
     }
     let (n, samples) = (n as usize, samples as usize);
-    if bytes.len() != 32 + n * samples * 12 {
+    let needed = n
+        .checked_mul(samples)
+        .and_then(|p| p.checked_mul(12))
+        .and_then(|b| b.checked_add(32));
+    if needed != Some(bytes.len()) {
         return Err(bad(&format!(
-            "PC2 of {samples} samples of {n} points needs {} bytes, the file has {}",
-            32 + n * samples * 12,
+            "PC2 of {samples} samples of {n} points does not fit the file's {} bytes",
             bytes.len()
         )));
     }
@@ -447,6 +450,11 @@ mod tests {
         let err = parse_pc2(&bytes[..40], Path::new("cut.pc2")).unwrap_err();
         assert!(err.to_string().contains("cut.pc2"), "{err}");
         assert!(parse_pc2(b"POINTCACHE3\0xxxxxxxxxxxxxxxxxxxx", Path::new("y.pc2")).is_err());
+        // Counts whose byte size overflows are refused, not wrapped.
+        let mut huge = bytes.clone();
+        huge[16..20].copy_from_slice(&i32::MAX.to_le_bytes());
+        huge[28..32].copy_from_slice(&i32::MAX.to_le_bytes());
+        assert!(parse_pc2(&huge, Path::new("huge.pc2")).is_err());
         assert!(encode_pc2(&[]).is_err());
     }
 }
