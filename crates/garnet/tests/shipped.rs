@@ -65,7 +65,7 @@ fn a_model_with_damaged_weights_is_refused_naming_it() {
 }
 
 #[test]
-fn models_that_learned_from_differently_posed_bodies_are_not_draped_together() {
+fn a_model_knows_its_body_skinning_and_draping_with_none_is_refused() {
     let device = Device::flex();
     let path = shipped_models_dir().join("tshirt-naive.garnet");
     let model = GarmentModel::load(&path, &device).unwrap();
@@ -73,9 +73,7 @@ fn models_that_learned_from_differently_posed_bodies_are_not_draped_together() {
     let bodies = BodyModel::load().unwrap();
     let target = bodies.shape(&Phenotype::default()).unwrap();
     let pose = Pose::identity(target.rig.len());
-    let err = drape(&[], &target, &pose, DrapeOptions::default())
-        .err()
-        .expect("no model");
+    let err = drape(&[], &target, &pose, DrapeOptions::default()).unwrap_err();
     assert!(err.to_string().contains("no model"), "{err}");
 }
 
