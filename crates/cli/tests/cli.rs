@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{fails, mocap_fixture, ok, s};
+use common::{fails, mocap_fixture, ok, s, walk_clip};
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -77,19 +77,7 @@ fn body_refuses_bad_parameters_and_files() {
 #[test]
 fn pose_convert_then_body_from_bvh_and_amc() {
     let dir = tempfile::tempdir().unwrap();
-    let mocap = mocap_fixture(dir.path(), &[("cmu/02/02_01.amc", 240)]).join("cmu");
-    let bvh = dir.path().join("walk.bvh");
-    let (asf, amc) = (mocap.join("02/02.asf"), mocap.join("02/02_01.amc"));
-    ok(&[
-        "pose",
-        "convert",
-        "--asf",
-        s(&asf),
-        "--amc",
-        s(&amc),
-        "--out",
-        s(&bvh),
-    ]);
+    let (_, amc, bvh) = walk_clip(dir.path(), 240);
     let from_bvh = dir.path().join("b.obj");
     let from_amc = dir.path().join("a.obj");
     ok(&[

@@ -10,20 +10,7 @@ use common::{fails, ok, repo, s};
 
 /// A 48-frame CMU-style walk as BVH in `dir`.
 fn walk_bvh(dir: &Path) -> PathBuf {
-    let amc = body::pose::synthetic_clip::write_cmu_clip(dir, "cmu/02/02_01.amc", 48).unwrap();
-    let bvh = dir.join("walk.bvh");
-    let asf = amc.with_file_name("02.asf");
-    ok(&[
-        "pose",
-        "convert",
-        "--asf",
-        s(&asf),
-        "--amc",
-        s(&amc),
-        "--out",
-        s(&bvh),
-    ]);
-    bvh
+    common::walk_clip(dir, 48).2
 }
 
 fn tshirt() -> PathBuf {

@@ -49,3 +49,22 @@ pub fn mocap_fixture(root: &Path, clips: &[(&str, usize)]) -> PathBuf {
     }
     root.to_path_buf()
 }
+
+/// A walk of `frames` frames garnet writes itself (`root/cmu/02/02.asf` and `02_01.amc`),
+/// converted by `garnet pose convert` to `root/walk.bvh`; returns (ASF, AMC, BVH).
+pub fn walk_clip(root: &Path, frames: usize) -> (PathBuf, PathBuf, PathBuf) {
+    let mocap = mocap_fixture(root, &[("cmu/02/02_01.amc", frames)]).join("cmu");
+    let (asf, amc) = (mocap.join("02/02.asf"), mocap.join("02/02_01.amc"));
+    let bvh = root.join("walk.bvh");
+    ok(&[
+        "pose",
+        "convert",
+        "--asf",
+        s(&asf),
+        "--amc",
+        s(&amc),
+        "--out",
+        s(&bvh),
+    ]);
+    (asf, amc, bvh)
+}
