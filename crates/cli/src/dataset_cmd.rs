@@ -1,4 +1,5 @@
-//! `garnet dataset`: check a spec, generate (sharded, resumable), merge, inspect, show.
+//! `garnet dataset`: check a spec, generate (sharded, resumable), merge, inspect, show,
+//! measure how repeatable the drapes are.
 
 use std::path::{Path, PathBuf};
 
@@ -23,6 +24,9 @@ pub enum DatasetCmd {
     Info(InfoArgs),
     /// A picture of one sample: the body, M (warped) and G (draped) side by side.
     Show(crate::dataset_show::ShowArgs),
+    /// How repeatable the labels are: samples draped at the spec's cloth density and 0.1%
+    /// above and below it, and the distances between the drapes.
+    Spread(crate::dataset_spread::SpreadArgs),
 }
 
 /// Where the mocap clips are.
@@ -139,6 +143,7 @@ pub fn run(cmd: &DatasetCmd) -> anyhow::Result<()> {
         DatasetCmd::Merge(a) => merge(a),
         DatasetCmd::Info(a) => info(a),
         DatasetCmd::Show(a) => crate::dataset_show::show(a),
+        DatasetCmd::Spread(a) => crate::dataset_spread::spread(a),
     }
 }
 

@@ -8,6 +8,7 @@ mod body_cmd;
 mod compare_cmd;
 mod dataset_cmd;
 mod dataset_show;
+mod dataset_spread;
 mod drape_cmd;
 mod drape_filter_args;
 mod drape_motion;
@@ -55,7 +56,7 @@ enum Cmd {
     Pose(pose_cmd::PoseCmd),
     /// Drape a garment template on a body with the cloth simulator.
     Simulate(simulate_cmd::SimulateArgs),
-    /// Datasets: check a spec, generate (sharded, resumable), merge, inspect, show.
+    /// Datasets: check a spec, generate (sharded, resumable), merge, inspect, show, spread.
     #[command(subcommand)]
     Dataset(dataset_cmd::DatasetCmd),
     /// Drape garments on a body with trained GarNet models (milliseconds, no simulation).

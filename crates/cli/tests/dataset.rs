@@ -439,3 +439,161 @@ fn generate_a_grown_compact_spec_reusing_a_smaller_dataset() {
     ]);
     assert!(err.contains("--reuse") && err.contains("seed"), "{err}");
 }
+
+/// 2 bodies x (T-shirt in 2 poses + jeans in 1) of coarse 5 cm garments in procedural
+/// poses (no mocap), a short settling: what `dataset spread` drapes in a few seconds.
+const SPREAD: &str = r#"
+format = 2
+name = "spread"
+seed = 4
+[bodies]
+count = 2
+[[garments]]
+kind = "tshirt"
+edge = 0.05
+poses_per_body = 2
+[[garments]]
+kind = "jeans"
+edge = 0.05
+poses_per_body = 1
+[[poses.procedural]]
+kind = "walk"
+count = 3
+[splits.bodies]
+train = 1
+test = 1
+[simulator]
+max_settle_steps = 30
+max_penetration = 0.05
+"#;
+
+#[test]
+fn spread_drapes_each_garment_three_times_and_reports_distances() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let spec = d.join("spread.toml");
+    std::fs::write(&spec, SPREAD).unwrap();
+    let settings = d.join("sim.toml");
+    std::fs::write(&settings, "max_settle_steps = 20\n").unwrap();
+    let (json, csv) = (d.join("out/report.json"), d.join("out/rows.csv"));
+    let out = ok(&[
+        "dataset",
+        "spread",
+        s(&spec),
+        "--per-garment",
+        "1",
+        "--jobs",
+        "2",
+        "--simulator",
+        s(&settings),
+        "--out",
+        s(&json),
+        "--csv",
+        s(&csv),
+    ]);
+    assert!(
+        out.contains("| garment |") && out.contains("| jeans |"),
+        "{out}"
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(report["split"], "test");
+    assert_eq!(report["spec_name"], "spread");
+    assert_eq!(report["spec_hash"].as_str().unwrap().len(), 64);
+    // The file's key over the spec's, the spec's other keys kept.
+    assert_eq!(report["simulator"]["max_settle_steps"], 20);
+    assert!((report["simulator"]["max_penetration"].as_f64().unwrap() - 0.05).abs() < 1e-6);
+    let densities = report["densities_kg_m2"].as_array().unwrap();
+    let d0 = densities[0].as_f64().unwrap();
+    assert!(
+        (densities[1].as_f64().unwrap() / d0 - 1.001).abs() < 1e-5,
+        "{densities:?}"
+    );
+    assert!(
+        (densities[2].as_f64().unwrap() / d0 - 0.999).abs() < 1e-5,
+        "{densities:?}"
+    );
+    let garments = report["garments"].as_array().unwrap();
+    let names: Vec<&str> = garments
+        .iter()
+        .map(|g| g["garment"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["tshirt", "jeans"]);
+    for g in garments {
+        assert_eq!(
+            (g["samples"].as_u64(), g["drapes"].as_u64()),
+            (Some(1), Some(3)),
+            "{g}"
+        );
+        assert_eq!(g["failed"], 0, "{g}");
+        for key in [
+            "e_dist_up_cm",
+            "e_dist_down_cm",
+            "e_dist_cm",
+            "e_norm_up_deg",
+            "e_norm_deg",
+        ] {
+            let v = g[key].as_f64().unwrap_or(f64::NAN);
+            assert!(v.is_finite() && v >= 0.0, "{key}: {g}");
+        }
+        assert!(g["median_settle_steps"].as_f64().unwrap() <= 20.0, "{g}");
+    }
+    let rows = report["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 2);
+    for r in rows {
+        assert_eq!(r["drapes"].as_array().unwrap().len(), 3, "{r}");
+    }
+    let csv = std::fs::read_to_string(&csv).unwrap();
+    assert_eq!(csv.lines().count(), 3, "{csv}");
+    assert!(
+        csv.starts_with("index,garment,body,pose,e_dist_up_cm"),
+        "{csv}"
+    );
+    // No temporary file is left beside the reports.
+    let names: Vec<String> = std::fs::read_dir(d.join("out"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names.len(), 2, "{names:?}");
+}
+
+#[test]
+fn spread_refuses_an_unknown_split_and_bad_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    let spec = dir.path().join("spread.toml");
+    std::fs::write(&spec, SPREAD).unwrap();
+    let json = dir.path().join("report.json");
+    let args = ["dataset", "spread", s(&spec), "--out", s(&json)];
+    for (extra, says) in [
+        (
+            &["--split", "tset"][..],
+            "no split 'tset' (the splits are test, train)",
+        ),
+        (&["--per-garment", "0"][..], "--per-garment"),
+        (&["--step", "0.2"][..], "(0, 0.1)"),
+    ] {
+        let err = fails(&[&args[..], extra].concat());
+        assert!(
+            err.contains(says) && err.contains("spread.toml"),
+            "{extra:?}: {err}"
+        );
+    }
+    assert!(!json.exists());
+    // A spec that names clips needs the mocap folder.
+    let clips = dir.path().join("clips.toml");
+    let text = SPREAD.replace(
+        "[[poses.procedural]]",
+        "[[poses.amc]]\nclips = [\"cmu/02/02_01.amc\"]\nevery = 50\n[[poses.procedural]]",
+    );
+    std::fs::write(&clips, text).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_garnet"))
+        .args(["dataset", "spread", s(&clips), "--out", s(&json)])
+        .env_remove("GARNET_MOCAP")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("clips.toml") && err.contains("--mocap DIR"),
+        "{err}"
+    );
+}

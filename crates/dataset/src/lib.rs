@@ -6,7 +6,8 @@
 //! safetensors [`shard`]s (a fixed range of sample indices each, byte-identical whatever
 //! the number of jobs, the interruptions or the `--shard i/n` split of the work) with a
 //! JSON [`manifest`]; generation resumes where it stopped; [`merge`](mod@merge) joins the folders
-//! of a job array. [`reader::Dataset`] reads samples back with checksums verified, and
+//! of a job array; [`spread`](mod@spread) measures how repeatable the simulator's drapes of a
+//! spec are. [`reader::Dataset`] reads samples back with checksums verified, and
 //! [`batches`] streams shuffled batches of a split without loading the dataset.
 //!
 //! Units: metres, Y up, the body facing +Z. Per sample: the posed body `[V,3]`, the
@@ -42,6 +43,7 @@ pub mod simulator;
 pub mod spec;
 pub mod spec_check;
 pub mod spec_load;
+pub mod spread;
 pub mod summary;
 pub mod templates;
 pub mod tensors;
@@ -56,4 +58,5 @@ pub use reader::{Dataset, Sample};
 pub use records::DrapeFilter;
 pub use selection::ShardSelection;
 pub use spec::{LoadedSpec, Spec};
+pub use spread::{spread, SpreadOptions, SpreadReport};
 pub use summary::Summary;

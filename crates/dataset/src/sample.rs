@@ -5,8 +5,9 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use body::shape_sampler::stature_and_bmi;
-use body::{BodyModel, ShapedBody, Skinning};
+use body::{BodyModel, Pose, ShapedBody, Skinning};
 use garment::warp::{warp, warp_fitted, SurfaceAnchors};
+use garment::GarmentTemplate;
 use sim::drape::{drape_morphed, DrapeOptions};
 use sim::morph::{morph, Morphed};
 
@@ -21,6 +22,10 @@ use crate::tensors::SampleArrays;
 
 /// A shaped body of the dataset, with its stature (m) and BMI (kg/m^2).
 pub type BodyEntry = Arc<(ShapedBody, f32, f32)>;
+
+/// What a sample drapes: its body, its garment template and its pose (see
+/// [`Maker::inputs`]).
+pub type SampleInputs = (BodyEntry, Arc<GarmentTemplate>, Pose);
 
 /// Everything a worker needs to make samples.
 pub struct Maker<'a> {
@@ -71,6 +76,32 @@ impl Maker<'_> {
             .map_err(|e| DatasetError::Body(body::BodyError::Parameter(e)))
     }
 
+    /// What sample `desc` drapes: its body (shape, stature, BMI), its garment template and
+    /// its pose as the pool gives it (before the simulator's limb clearance). `Ok(Err(m))`:
+    /// the sample cannot be made (a cut that cannot be built, a pose that cannot be
+    /// found), and why; errors are problems of the machine or the installation.
+    pub fn inputs(&self, desc: &SampleDesc) -> Result<std::result::Result<SampleInputs, String>> {
+        let garment = &self.plan.garments[desc.garment];
+        let body = self.body(desc.body)?;
+        let template =
+            match self
+                .templates
+                .get(self.model, self.plan.seed, desc.garment, garment, desc.body)
+            {
+                Ok(t) => t,
+                Err(TemplateError::Build(m)) => return Ok(Err(m)),
+                Err(TemplateError::Save(m)) => return Err(DatasetError::Invalid(m)),
+            };
+        let pose = match self
+            .library
+            .pose(self.spec, self.plan.pool.poses[desc.pose], &body.0)
+        {
+            Ok(p) => p,
+            Err(m) => return Ok(Err(m)),
+        };
+        Ok(Ok((body, template, pose)))
+    }
+
     /// Makes sample `desc`. A failed drape (or a pose or cut that cannot be made) is an
     /// [`Outcome::Failed`]; errors are problems of the machine or the installation.
     pub fn make(&self, desc: &SampleDesc) -> Result<(Outcome, Timing)> {
@@ -93,24 +124,11 @@ impl Maker<'_> {
             };
             Ok((Outcome::Failed(f), t))
         };
-        let body = self.body(desc.body)?;
-        let (target, stature, bmi) = (&body.0, body.1, body.2);
-        let template =
-            match self
-                .templates
-                .get(self.model, self.plan.seed, desc.garment, garment, desc.body)
-            {
-                Ok(t) => t,
-                Err(TemplateError::Build(m)) => return fail(m, 0.0),
-                Err(TemplateError::Save(m)) => return Err(DatasetError::Invalid(m)),
-            };
-        let pose = match self
-            .library
-            .pose(self.spec, self.plan.pool.poses[desc.pose], target)
-        {
-            Ok(p) => p,
+        let (body, template, pose) = match self.inputs(desc)? {
+            Ok(inputs) => inputs,
             Err(m) => return fail(m, 0.0),
         };
+        let (target, stature, bmi) = (&body.0, body.1, body.2);
         let opts = &self.drape_options;
         let morphed = self.morphs.get_or_init(&(desc.garment, desc.body), || {
             morph(

@@ -25,7 +25,8 @@ pub type TemplateResult = Result<Arc<GarmentTemplate>, TemplateError>;
 
 /// Templates of a dataset folder, built or loaded on first use.
 pub struct TemplateStore {
-    dir: PathBuf,
+    /// The dataset folder; `None`: templates are built in memory and never saved.
+    dir: Option<PathBuf>,
     cache: KeyedCache<String, TemplateResult>,
 }
 
@@ -33,14 +34,24 @@ impl TemplateStore {
     /// The templates of dataset folder `dir`, keeping at most `capacity` in memory.
     pub fn new(dir: &Path, capacity: usize) -> Self {
         Self {
-            dir: dir.to_path_buf(),
+            dir: Some(dir.to_path_buf()),
+            cache: KeyedCache::new(capacity),
+        }
+    }
+
+    /// Templates without a dataset folder: each built on first use and kept in memory only
+    /// (at most `capacity` of them); nothing is read or written.
+    pub fn in_memory(capacity: usize) -> Self {
+        Self {
+            dir: None,
             cache: KeyedCache::new(capacity),
         }
     }
 
     /// The template body `body` wears of `garment` (index `g`, dataset `seed`): read from
-    /// its file if a run saved it, else built (with the body's cut) and saved. The error
-    /// says why the template could not be built or saved.
+    /// its file if a run saved it, else built (with the body's cut) and saved (in memory
+    /// only for [`TemplateStore::in_memory`]). The error says why the template could not
+    /// be built or saved.
     pub fn get(
         &self,
         model: &BodyModel,
@@ -51,17 +62,19 @@ impl TemplateStore {
     ) -> TemplateResult {
         let id = garment.template_id(body);
         self.cache.get_or_init(&id, || {
-            let path = self.dir.join(template_file(&id));
-            if path.is_file() {
-                if let Ok(t) = GarmentTemplate::load(&path) {
+            let path = self.dir.as_ref().map(|d| d.join(template_file(&id)));
+            if let Some(path) = path.as_ref().filter(|p| p.is_file()) {
+                if let Ok(t) = GarmentTemplate::load(path) {
                     return Ok(Arc::new(t));
                 }
             }
             let cut = garment.cut_for(seed, g, body);
             let t = build_template(model, &garment.kind, &cut, garment.edge)
                 .map_err(|e| TemplateError::Build(format!("template {id}: {e}")))?;
-            t.save(&path)
-                .map_err(|e| TemplateError::Save(format!("saving template {id}: {e}")))?;
+            if let Some(path) = &path {
+                t.save(path)
+                    .map_err(|e| TemplateError::Save(format!("saving template {id}: {e}")))?;
+            }
             Ok(Arc::new(t))
         })
     }
