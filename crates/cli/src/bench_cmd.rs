@@ -25,6 +25,17 @@ pub enum BenchCmd {
         /// Seed of the random shape and procedural pose.
         #[arg(long, default_value_t = 5)]
         seed: u64,
+        /// Drapes of each setting, taken in turn (the medians are reported).
+        #[arg(long, default_value_t = 3)]
+        runs: usize,
+        /// Simulator settings of the drape timed (a spec or settings file, as
+        /// `garnet simulate --simulator`); the simulator's defaults when absent.
+        #[arg(long, value_name = "FILE.toml")]
+        simulator: Option<std::path::PathBuf>,
+        /// Simulator settings of a reference drape timed in turn with it (e.g. an older
+        /// benchmark's spec), reported as a ratio.
+        #[arg(long, value_name = "FILE.toml")]
+        reference: Option<std::path::PathBuf>,
     },
     /// GarNet: forward time per drape of each variant at two garment sizes, and a
     /// training step, against the DQS warp of the 1 cm T-shirt.
@@ -56,7 +67,19 @@ pub enum BenchCmd {
 pub fn run(cmd: &BenchCmd) -> anyhow::Result<()> {
     match cmd {
         BenchCmd::Body { repeat } => bench_body(*repeat.max(&3)),
-        BenchCmd::Sim { edge, seed } => bench_sim(*edge, *seed),
+        BenchCmd::Sim {
+            edge,
+            seed,
+            runs,
+            simulator,
+            reference,
+        } => bench_sim(
+            *edge,
+            *seed,
+            (*runs).max(1),
+            simulator.as_deref(),
+            reference.as_deref(),
+        ),
         BenchCmd::Model {
             runs,
             sizes,
@@ -193,9 +216,18 @@ impl TshirtCase {
     /// Drapes the T-shirt on the posed body with the simulator (default options, except
     /// that penetration is reported instead of failing the drape).
     pub fn simulate(&self) -> anyhow::Result<sim::drape::Drape> {
+        self.simulate_with(&sim::drape::DrapeOptions::default())
+    }
+
+    /// Drapes the T-shirt on the posed body with the simulator settings `opts`, except
+    /// that penetration is reported instead of failing the drape.
+    pub fn simulate_with(
+        &self,
+        opts: &sim::drape::DrapeOptions,
+    ) -> anyhow::Result<sim::drape::Drape> {
         let opts = sim::drape::DrapeOptions {
             max_penetration: f32::INFINITY,
-            ..sim::drape::DrapeOptions::default()
+            ..opts.clone()
         };
         Ok(sim::drape::drape(
             &self.template,
@@ -208,19 +240,55 @@ impl TshirtCase {
     }
 }
 
-fn bench_sim(edge: f32, seed: u64) -> anyhow::Result<()> {
+/// Simulator settings of a file, or the defaults.
+fn drape_options(path: Option<&std::path::Path>) -> anyhow::Result<sim::drape::DrapeOptions> {
+    Ok(match path {
+        Some(p) => dataset::simulator::load_drape_options(p)?,
+        None => sim::drape::DrapeOptions::default(),
+    })
+}
+
+/// The drape of the median wall time of `drapes`.
+fn median_drape(mut drapes: Vec<sim::drape::Drape>) -> sim::drape::Drape {
+    drapes.sort_by(|a, b| a.stats.wall_time_s.total_cmp(&b.stats.wall_time_s));
+    drapes.swap_remove(drapes.len() / 2)
+}
+
+fn bench_sim(
+    edge: f32,
+    seed: u64,
+    runs: usize,
+    simulator: Option<&std::path::Path>,
+    reference: Option<&std::path::Path>,
+) -> anyhow::Result<()> {
     let model = BodyModel::load()?;
     let case = TshirtCase::new(&model, edge, seed)?;
     let (template, warp) = (&case.template, case.warp);
-    let result = case.simulate()?;
+    let opts = drape_options(simulator)?;
+    let ref_opts = reference.map(|p| drape_options(Some(p))).transpose()?;
+    // The two settings in turn, so that a machine's drift affects both alike.
+    let (mut drapes, mut refs) = (Vec::new(), Vec::new());
+    for _ in 0..runs {
+        drapes.push(case.simulate_with(&opts)?);
+        if let Some(r) = &ref_opts {
+            refs.push(case.simulate_with(r)?);
+        }
+    }
+    let result = median_drape(drapes);
     let s = &result.stats;
     let steps = s.animation_steps + s.settle_steps;
-    let per_step = s.wall_time_s / steps as f64;
+    let per_step = s.wall_time_s / steps.max(1) as f64;
+    let name = |p: Option<&std::path::Path>| {
+        p.map_or("the simulator's defaults".to_string(), |p| {
+            p.display().to_string()
+        })
+    };
     println!(
-        "garnet bench sim: {}-vertex T-shirt ({} cm edges) on random shape {seed} in a procedural walk pose, {} threads",
+        "garnet bench sim: {}-vertex T-shirt ({} cm edges) on random shape {seed} in a procedural walk pose, {} threads, medians of {runs}; settings: {}",
         template.mesh.vertices.len(),
         edge * 100.0,
-        rayon::current_num_threads()
+        rayon::current_num_threads(),
+        name(simulator)
     );
     println!("| measure | value | ratio to DQS warp (M) |");
     println!("|---|---:|---:|");
@@ -244,13 +312,22 @@ fn bench_sim(edge: f32, seed: u64) -> anyhow::Result<()> {
         s.wall_time_s / warp.as_secs_f64()
     );
     println!("{}", s.summary());
-    println!(
-        "target under 5 s to rest on 2 cores: {}",
-        if s.converged && s.wall_time_s < 5.0 {
-            "met"
-        } else {
-            "missed"
-        }
-    );
+    if !refs.is_empty() {
+        let r = median_drape(refs);
+        let rs = &r.stats;
+        println!(
+            "reference ({}): {:.2} s, {} + {} steps, {}; time against the reference: {:.2}",
+            name(reference),
+            rs.wall_time_s,
+            rs.animation_steps,
+            rs.settle_steps,
+            if rs.converged {
+                "at rest"
+            } else {
+                "not at rest"
+            },
+            s.wall_time_s / rs.wall_time_s
+        );
+    }
     Ok(())
 }

@@ -59,6 +59,14 @@ impl SimulatorSpec {
                 )
             })?;
         }
+        if let Some(s) = &self.start {
+            o.start = sim::drape::Start::from_name(s).ok_or_else(|| {
+                (
+                    "start".to_string(),
+                    format!("'{s}' is not a start (animate or fitted)"),
+                )
+            })?;
+        }
         if let Err(e) = o.cloth.validate() {
             let text = e.to_string();
             // The simulator's message starts with the field name after its prefix.
@@ -157,5 +165,20 @@ mod tests {
             ..Default::default()
         };
         assert_eq!(bad.drape_options().unwrap_err().0, "rest_speed");
+        let fitted = SimulatorSpec {
+            start: Some("fitted".into()),
+            ..Default::default()
+        };
+        assert_eq!(
+            fitted.drape_options().unwrap().start,
+            sim::drape::Start::Fitted
+        );
+        let bad = SimulatorSpec {
+            start: Some("teleport".into()),
+            ..Default::default()
+        };
+        let (field, message) = bad.drape_options().unwrap_err();
+        assert_eq!(field, "start");
+        assert!(message.contains("'teleport'"), "{message}");
     }
 }

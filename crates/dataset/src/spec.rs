@@ -254,6 +254,12 @@ pub struct SimulatorSpec {
     /// Give a garment with a waistband (the jeans) its elastic band
     /// (`sim::waistband::Waistband::default`); the simulator's default (on) when absent.
     pub waistband: Option<bool>,
+    /// Where the cloth starts: `animate` (carried from the template body through the shape
+    /// and pose animation) or `fitted` (placed on the posed target by surface anchors);
+    /// the simulator's default when absent. Left out of the spec's hash when absent, so
+    /// specs written before it keep theirs.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start: Option<String>,
 }
 
 /// Optional arrays stored per sample.

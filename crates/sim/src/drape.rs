@@ -69,6 +69,41 @@ pub struct DrapeOptions {
     /// the waist's girth, so that it holds the garment up. `None`: the band is cloth like
     /// the rest.
     pub waistband: Option<Waistband>,
+    /// Where the cloth starts: carried along by the body from the template body
+    /// ([`Start::Animate`]) or placed on the posed target by its surface anchors
+    /// ([`Start::Fitted`]).
+    pub start: Start,
+}
+
+/// How a drape reaches the target body.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Start {
+    /// The garment starts on the template body; the body morphs into the target shape,
+    /// then moves into the target pose, the cloth following by contact and friction.
+    Animate,
+    /// The garment starts on the posed target, placed by the template's surface anchors
+    /// (each vertex keeps its offset in the frame of its closest skin point), is moved out
+    /// of the body, and settles there: no shape or pose animation.
+    Fitted,
+}
+
+impl Start {
+    /// The method of a name: `animate` or `fitted`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "animate" => Some(Start::Animate),
+            "fitted" => Some(Start::Fitted),
+            _ => None,
+        }
+    }
+
+    /// The name [`Start::from_name`] reads.
+    pub fn name(self) -> &'static str {
+        match self {
+            Start::Animate => "animate",
+            Start::Fitted => "fitted",
+        }
+    }
 }
 
 impl Default for DrapeOptions {
@@ -87,6 +122,7 @@ impl Default for DrapeOptions {
             grade: true,
             clearance: Some(ClearanceOptions::default()),
             waistband: Some(Waistband::default()),
+            start: Start::Animate,
         }
     }
 }
@@ -184,12 +220,28 @@ pub fn drape_morphed(
             .map_err(|e| SimError::InvalidInput(e.to_string()))?
             .vertices)
     };
-    let pose_steps = phase_steps(opts.pose_steps, opts.body_step, POSE_PATH_SAMPLES, &posed)?;
-    let mut body = target.mesh.vertices.clone();
-    for k in 1..=pose_steps {
-        body = posed(k as f32 / pose_steps as f32)?;
-        m.advance(&body, opts, on_frame)?;
-    }
+    let body = match opts.start {
+        Start::Animate => {
+            let pose_steps =
+                phase_steps(opts.pose_steps, opts.body_step, POSE_PATH_SAMPLES, &posed)?;
+            let mut body = target.mesh.vertices.clone();
+            for k in 1..=pose_steps {
+                body = posed(k as f32 / pose_steps as f32)?;
+                m.advance(&body, opts, on_frame)?;
+            }
+            body
+        }
+        Start::Fitted => {
+            let body = posed(1.0)?;
+            let start = m.anchors.place(&TriMesh {
+                vertices: body.clone(),
+                faces: target.mesh.faces.clone(),
+            });
+            m.place_at(&body, &start)?;
+            on_frame(m.steps, m.sim.positions(), &body);
+            body
+        }
+    };
     let animation_steps = m.steps;
     let mut converged = false;
     let mut walked = 0;

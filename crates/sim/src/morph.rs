@@ -11,7 +11,7 @@ use garment::GarmentTemplate;
 use geom::TriMesh;
 use glam::Vec3;
 
-use crate::drape::{DrapeOptions, FrameObserver};
+use crate::drape::{DrapeOptions, FrameObserver, Start};
 use crate::{BodyCollider, ClothSim, SimError};
 
 /// The cloth on the target body in its rest pose, after the shape morph.
@@ -69,9 +69,15 @@ pub fn morph(
     };
     let mut sim = ClothSim::with_stretch_scale(&rest, &opts.cloth, &stretch_scale)?;
     sim.set_positions(&template.mesh.vertices)?;
+    let fitted = opts.start != Start::Animate;
+    let start_body = if fitted {
+        &target.mesh
+    } else {
+        &template_body.mesh
+    };
     let mut m = Morphed {
         sim,
-        collider: BodyCollider::new(&template_body.mesh, opts.cloth.thickness)?,
+        collider: BodyCollider::new(start_body, opts.cloth.thickness)?,
         anchors,
         steps: 0,
         mass: cloth_mass(&template.mesh, opts.cloth.density),
@@ -87,7 +93,11 @@ pub fn morph(
             .map(|(a, b)| a.lerp(*b, t))
             .collect())
     };
-    let morph_steps = crate::drape::phase_steps(opts.morph_steps, opts.body_step, 1, &morphed)?;
+    let morph_steps = if fitted {
+        0
+    } else {
+        crate::drape::phase_steps(opts.morph_steps, opts.body_step, 1, &morphed)?
+    };
     for k in 1..=morph_steps {
         let body = morphed(k as f32 / morph_steps as f32)?;
         m.advance(&body, opts, on_frame)?;
@@ -125,6 +135,17 @@ impl Morphed {
     /// Root-mean-square speed of the cloth, m/s.
     pub(crate) fn rms_speed(&self) -> f32 {
         (2.0 * self.sim.kinetic_energy() / self.mass).sqrt()
+    }
+
+    /// Holds the body at `body` (`[V]` metres) and places the cloth at `start` (`[N]`
+    /// metres), at rest, moving every vertex inside the body (or nearer it than half the
+    /// thickness) out.
+    pub(crate) fn place_at(&mut self, body: &[Vec3], start: &[Vec3]) -> Result<(), SimError> {
+        self.collider.move_to(body)?;
+        self.collider.commit();
+        self.sim.set_positions(start)?;
+        self.sim.project_out_of(&self.collider);
+        Ok(())
     }
 
     /// One step with the body at `body` (`[V]` metres): errors if the cloth diverged.
