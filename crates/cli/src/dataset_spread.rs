@@ -32,6 +32,9 @@ pub struct SpreadArgs {
     /// in (0, 0.1).
     #[arg(long, value_name = "S", default_value_t = DEFAULT_STEP)]
     pub step: f32,
+    /// Of the spec's garments, only these (comma-separated names, e.g. jeans).
+    #[arg(long, value_name = "NAME,...", value_delimiter = ',')]
+    pub garment: Vec<String>,
     /// Drapes in parallel (default: one per core).
     #[arg(long)]
     pub jobs: Option<usize>,
@@ -67,6 +70,7 @@ pub fn spread(args: &SpreadArgs) -> anyhow::Result<()> {
     opts.split.clone_from(&args.split);
     opts.per_garment = args.per_garment;
     opts.step = args.step;
+    opts.garments.clone_from(&args.garment);
     opts.simulator.clone_from(&args.simulator);
     let model = BodyModel::load()?;
     let bar = ProgressBar::new(0);

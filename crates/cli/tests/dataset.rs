@@ -555,6 +555,26 @@ fn spread_drapes_each_garment_three_times_and_reports_distances() {
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
     assert_eq!(names.len(), 2, "{names:?}");
+    // --garment measures only the garments it names.
+    ok(&[
+        "dataset",
+        "spread",
+        s(&spec),
+        "--per-garment",
+        "1",
+        "--garment",
+        "jeans",
+        "--simulator",
+        s(&settings),
+        "--out",
+        s(&json),
+    ]);
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let garments = report["garments"].as_array().unwrap();
+    assert_eq!(garments.len(), 1);
+    assert_eq!(garments[0]["garment"], "jeans");
+    assert_eq!(report["rows"].as_array().unwrap().len(), 1);
 }
 
 #[test]
@@ -571,6 +591,10 @@ fn spread_refuses_an_unknown_split_and_bad_counts() {
         ),
         (&["--per-garment", "0"][..], "--per-garment"),
         (&["--step", "0.2"][..], "(0, 0.1)"),
+        (
+            &["--garment", "jeans,skirt"][..],
+            "no garment 'skirt' (the garments are tshirt, jeans)",
+        ),
     ] {
         let err = fails(&[&args[..], extra].concat());
         assert!(

@@ -56,6 +56,8 @@ pub struct SpreadOptions<'a> {
     /// Relative density step `s`, in `(0, MAX_STEP)`: the other drapes use `d (1 + s)` and
     /// `d (1 - s)` kg/m^2.
     pub step: f32,
+    /// The garments measured, by name (empty: every garment of the spec).
+    pub garments: Vec<String>,
     /// Worker threads (drapes in parallel).
     pub jobs: usize,
     /// A simulator settings file (see [`SimulatorSpec::load`]) whose keys replace those of
@@ -75,6 +77,7 @@ impl SpreadOptions<'_> {
             split: DEFAULT_SPLIT.to_string(),
             per_garment: DEFAULT_PER_GARMENT,
             step: DEFAULT_STEP,
+            garments: Vec::new(),
             jobs: std::thread::available_parallelism().map_or(1, |n| n.get()),
             simulator: None,
             mocap_root,
@@ -169,6 +172,13 @@ pub fn spread(
             opts.split
         )));
     }
+    let garment_names: Vec<&str> = plan.garments.iter().map(|g| g.name.as_str()).collect();
+    DatasetError::check_known(
+        "garment",
+        opts.garments.iter().map(String::as_str),
+        &garment_names,
+    )
+    .map_err(|e| DatasetError::Invalid(format!("{file}: {e}")))?;
     let simulator = match &opts.simulator {
         Some(path) => merged_simulator(&spec.spec.simulator, &SimulatorSpec::load(path)?),
         None => spec.spec.simulator.clone(),
@@ -196,7 +206,12 @@ pub fn spread(
         bodies: KeyedCache::new(2 * jobs + 4),
         morphs: KeyedCache::new(1),
     };
-    let chosen = chosen_samples(&plan, split, opts.per_garment);
+    let mut chosen = chosen_samples(&plan, split, opts.per_garment);
+    for (samples, name) in chosen.iter_mut().zip(&garment_names) {
+        if !opts.garments.is_empty() && !opts.garments.iter().any(|g| g == name) {
+            samples.clear();
+        }
+    }
     let total = 3 * chosen.iter().map(Vec::len).sum::<usize>() as u64;
     let (done, failed) = (AtomicU64::new(0), AtomicU64::new(0));
     let notify = |drapes: u64, failures: u64| {
@@ -217,6 +232,9 @@ pub fn spread(
         .map_err(|e| DatasetError::Invalid(format!("starting {jobs} threads: {e}")))?;
     let (mut garments, mut rows) = (Vec::new(), Vec::new());
     for (g, samples) in chosen.iter().enumerate() {
+        if samples.is_empty() && !opts.garments.is_empty() {
+            continue;
+        }
         let tg = Instant::now();
         let made: Vec<Result<SpreadRow>> = pool.install(|| {
             samples
