@@ -261,11 +261,11 @@ fn bench_sim(
     simulator: Option<&std::path::Path>,
     reference: Option<&std::path::Path>,
 ) -> anyhow::Result<()> {
+    let opts = drape_options(simulator)?;
+    let ref_opts = reference.map(|p| drape_options(Some(p))).transpose()?;
     let model = BodyModel::load()?;
     let case = TshirtCase::new(&model, edge, seed)?;
     let (template, warp) = (&case.template, case.warp);
-    let opts = drape_options(simulator)?;
-    let ref_opts = reference.map(|p| drape_options(Some(p))).transpose()?;
     // The two settings in turn, so that a machine's drift affects both alike.
     let (mut drapes, mut refs) = (Vec::new(), Vec::new());
     for _ in 0..runs {

@@ -146,6 +146,52 @@ fn body_sheet_renders_five_shapes_in_five_poses() {
     );
 }
 
+/// `bench sim` times a drape with one simulator settings file against another, in turn,
+/// and reports their ratio; a bad file is refused, naming it.
+#[test]
+fn bench_sim_compares_two_settings() {
+    let dir = tempfile::tempdir().unwrap();
+    let fitted = dir.path().join("fitted.toml");
+    std::fs::write(
+        &fitted,
+        "start = \"fitted\"\ndamping = 10000.0\nmax_settle_steps = 30\n",
+    )
+    .unwrap();
+    let animated = dir.path().join("animated.toml");
+    std::fs::write(&animated, "max_settle_steps = 30\n").unwrap();
+    let out = ok(&[
+        "bench",
+        "sim",
+        "--edge",
+        "0.06",
+        "--runs",
+        "2",
+        "--simulator",
+        s(&fitted),
+        "--reference",
+        s(&animated),
+    ]);
+    assert!(
+        out.contains("medians of 2") && out.contains("fitted.toml"),
+        "{out}"
+    );
+    // The fitted drape has no animation steps; the reference has the morph and the pose.
+    assert!(
+        out.contains("| steps (animation + settling) | 0 + "),
+        "{out}"
+    );
+    let reference = out.lines().find(|l| l.starts_with("reference (")).unwrap();
+    assert!(
+        reference.contains("animated.toml") && reference.contains("time against the reference"),
+        "{out}"
+    );
+    assert!(!reference.contains(" 0 + "), "{reference}");
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "start = \"teleport\"\n").unwrap();
+    let err = fails(&["bench", "sim", "--edge", "0.06", "--reference", s(&bad)]);
+    assert!(err.contains("bad.toml") && err.contains("start"), "{err}");
+}
+
 #[test]
 fn bench_body_reports_ratios() {
     let out = ok(&["bench", "body", "--repeat", "3"]);
