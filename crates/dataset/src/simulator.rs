@@ -38,6 +38,7 @@ impl SimulatorSpec {
         set(&mut c.dt, self.dt);
         set(&mut c.chebyshev_rho, self.chebyshev_rho);
         c.iterations = self.iterations.unwrap_or(c.iterations);
+        c.static_friction = self.static_friction.unwrap_or(c.static_friction);
         o.morph_steps = self.morph_steps.unwrap_or(o.morph_steps);
         o.pose_steps = self.pose_steps.unwrap_or(o.pose_steps);
         set(&mut o.body_step, self.body_step);
@@ -167,12 +168,12 @@ mod tests {
         assert_eq!(bad.drape_options().unwrap_err().0, "rest_speed");
         let fitted = SimulatorSpec {
             start: Some("fitted".into()),
+            static_friction: Some(true),
             ..Default::default()
         };
-        assert_eq!(
-            fitted.drape_options().unwrap().start,
-            sim::drape::Start::Fitted
-        );
+        let o = fitted.drape_options().unwrap();
+        assert_eq!(o.start, sim::drape::Start::Fitted);
+        assert!(o.cloth.static_friction);
         let bad = SimulatorSpec {
             start: Some("teleport".into()),
             ..Default::default()

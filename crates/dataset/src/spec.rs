@@ -260,6 +260,10 @@ pub struct SimulatorSpec {
     /// specs written before it keep theirs.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub start: Option<String>,
+    /// Static friction that holds (`sim::ClothParams::static_friction`); left out of the
+    /// hash when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub static_friction: Option<bool>,
 }
 
 /// Optional arrays stored per sample.

@@ -217,21 +217,27 @@ fn the_benchmarks_name_every_setting() {
     for file in ["standard-lbs.toml", "standard-fitted.toml"] {
         check_names_every_setting(file);
     }
-    // standard-lbs was written before `start` existed, so it names none (its hash stays
-    // the same): it relies on the default staying the animated path.
+    // standard-lbs was written before `start` and `static_friction` existed, so it names
+    // neither (its hash stays the same): it relies on their defaults staying the animated
+    // path and the creeping friction.
     let lbs = LoadedSpec::load(&repo_spec("standard-lbs.toml"))
         .unwrap()
         .spec;
-    assert_eq!(lbs.simulator.start, None);
+    assert_eq!(
+        (&lbs.simulator.start, lbs.simulator.static_friction),
+        (&None, None)
+    );
     let opts = lbs.simulator.drape_options().unwrap();
     assert_eq!(opts.start, sim::drape::Start::Animate);
+    assert!(!opts.cloth.static_friction);
     let fitted = LoadedSpec::load(&repo_spec("standard-fitted.toml"))
         .unwrap()
         .spec;
     assert_eq!(fitted.simulator.start.as_deref(), Some("fitted"));
+    assert_eq!(fitted.simulator.static_friction, Some(true));
 }
 
-/// Every simulator setting (but `start`, see above), the whole cut of each garment and the
+/// Every simulator setting (but `start` and `static_friction`, see above), the whole cut of each garment and the
 /// whole shape distribution are written out in `file`.
 fn check_names_every_setting(file: &str) {
     let text = std::fs::read_to_string(repo_spec(file)).unwrap();

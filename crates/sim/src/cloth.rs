@@ -85,6 +85,9 @@ pub struct ClothSim {
     pub(crate) known: Vec<Option<crate::step::KnownHit>>,
     /// `[N]` lower bounds of the vertices' distances to the body (or none).
     pub(crate) far: Vec<Option<crate::step::FarBound>>,
+    /// `[N]` with [`ClothParams::static_friction`]: where each vertex that stuck to the body
+    /// in the last step is held (its friction anchor, metres; none for the others).
+    pub(crate) stick: Vec<Option<glam::DVec3>>,
 }
 
 impl ClothSim {
@@ -139,6 +142,7 @@ impl ClothSim {
             near_face: vec![crate::collide::NO_FACE; n],
             known: Vec::new(),
             far: vec![None; n],
+            stick: vec![None; n],
         };
         sim.build_system()?;
         Ok(sim)
@@ -284,6 +288,7 @@ impl ClothSim {
         self.v.fill(Vec3::ZERO);
         self.last_force.fill(0.0);
         self.body_vel.fill(Vec3::ZERO);
+        self.stick.fill(None);
         Ok(())
     }
 

@@ -55,6 +55,12 @@ pub struct ClothParams {
     /// gains where other drapes keep every thread busy (the dataset's workers: 27.3 against
     /// 31.8 s of CPU for 18 drapes on two jobs; README "Simulator").
     pub split_solve: bool,
+    /// Static friction that holds: a vertex that sticks to the body keeps its friction
+    /// anchor from step to step (carried by the body) until it slides, instead of taking
+    /// its new place as the next step's anchor. Without it the contact spring's stretch
+    /// under a steady tangential load is given up every step, and cloth held by friction
+    /// creeps.
+    pub static_friction: bool,
 }
 
 impl Default for ClothParams {
@@ -76,6 +82,7 @@ impl Default for ClothParams {
             iterations: 8,
             chebyshev_rho: 0.95,
             split_solve: true,
+            static_friction: false,
         }
     }
 }

@@ -61,6 +61,16 @@ impl Contact {
         q
     }
 
+    /// The anchor, when `x` holds to it by static friction: its tangential distance from the
+    /// anchor is inside Coulomb's cone of [`Contact::target`] (at most `mu` times the push
+    /// out of the thickness layer, and the push is positive).
+    pub fn sticks(&self, x: DVec3, thick: f64, mu: f64) -> Option<DVec3> {
+        let push = (thick - self.height(x)).max(0.0);
+        let d = self.anchor - x;
+        let dt = d - self.normal * self.normal.dot(d);
+        (mu > 0.0 && push > 0.0 && dt.length() <= mu * push).then_some(self.anchor)
+    }
+
     /// `x` moved out of the thickness layer along the normal (no friction).
     #[inline]
     pub fn push_out(&self, x: DVec3, thick: f64) -> DVec3 {

@@ -150,6 +150,14 @@ impl ClothSim {
         }
 
         // 5. Velocities and contact forces; friction for contacts the solve did not hold.
+        let stick: Vec<Option<DVec3>> = (0..n)
+            .map(|i| match (&contacts[i], active[i] && self.factored[i]) {
+                (Some(c), true) if p.static_friction => {
+                    c.sticks(xs[i], thick as f64, p.friction as f64)
+                }
+                _ => None,
+            })
+            .collect();
         let mut x1: Vec<Vec3> = xs.iter().map(|p| p.as_vec3()).collect();
         let mut v1: Vec<Vec3> = (0..n).map(|i| (x1[i] - self.x[i]) / p.dt).collect();
         let mut force = vec![0.0f64; n];
@@ -241,6 +249,7 @@ impl ClothSim {
         self.x = x1;
         self.v = v1;
         self.last_force = force;
+        self.stick = stick;
         self.steps_taken += 1;
         if let Some(c) = collider {
             c.commit();
@@ -390,11 +399,13 @@ fn find_contacts(
                     if hit.distance <= reach {
                         let (pt, nrm) = c.plane_cur(hit.face, hit.bary);
                         let carry = c.displacement(hit.face, hit.bary);
+                        let held =
+                            sim.stick[i].filter(|a| a.distance(x[i].as_dvec3()) < STICK_REACH_M);
                         *ct = Some(Contact {
                             carry: carry.as_dvec3(),
                             point: pt.as_dvec3(),
                             normal: nrm.as_dvec3(),
-                            anchor: (x[i] + carry).as_dvec3(),
+                            anchor: held.unwrap_or(x[i].as_dvec3()) + carry.as_dvec3(),
                         });
                     }
                 }
@@ -402,6 +413,10 @@ fn find_contacts(
             }
         });
 }
+
+/// A held friction anchor farther than this from its vertex (metres) is let go: the
+/// vertex was moved (projected or walked out of the body) since it stuck.
+const STICK_REACH_M: f64 = 0.004;
 
 /// Searches reach at least this far (metres) while the body holds still, so that a vertex
 /// away from it gets a lower bound of its distance ([`FarBound`]) and is not searched
