@@ -237,8 +237,8 @@ fn the_benchmarks_name_every_setting() {
     assert_eq!(fitted.simulator.static_friction, Some(true));
 }
 
-/// Every simulator setting (but `start` and `static_friction`, see above), the whole cut of each garment and the
-/// whole shape distribution are written out in `file`.
+/// Every simulator setting (but `start` and `static_friction`, see above), the whole cut
+/// of each garment and the whole shape distribution are written out in `file`.
 fn check_names_every_setting(file: &str) {
     let text = std::fs::read_to_string(repo_spec(file)).unwrap();
     let table: toml::Table = toml::from_str(&text).unwrap();
