@@ -240,14 +240,6 @@ impl TshirtCase {
     }
 }
 
-/// Simulator settings of a file, or the defaults.
-fn drape_options(path: Option<&std::path::Path>) -> anyhow::Result<sim::drape::DrapeOptions> {
-    Ok(match path {
-        Some(p) => dataset::simulator::load_drape_options(p)?,
-        None => sim::drape::DrapeOptions::default(),
-    })
-}
-
 /// The drape of the median wall time of `drapes`.
 fn median_drape(mut drapes: Vec<sim::drape::Drape>) -> sim::drape::Drape {
     drapes.sort_by(|a, b| a.stats.wall_time_s.total_cmp(&b.stats.wall_time_s));
@@ -261,8 +253,9 @@ fn bench_sim(
     simulator: Option<&std::path::Path>,
     reference: Option<&std::path::Path>,
 ) -> anyhow::Result<()> {
-    let opts = drape_options(simulator)?;
-    let ref_opts = reference.map(|p| drape_options(Some(p))).transpose()?;
+    use dataset::simulator::{load_drape_options, load_drape_options_or_default};
+    let opts = load_drape_options_or_default(simulator)?;
+    let ref_opts = reference.map(load_drape_options).transpose()?;
     let model = BodyModel::load()?;
     let case = TshirtCase::new(&model, edge, seed)?;
     let (template, warp) = (&case.template, case.warp);

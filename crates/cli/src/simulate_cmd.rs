@@ -182,10 +182,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
 /// The drape options of `args`: the defaults, then the `--simulator` file's settings, then
 /// the flags.
 fn drape_options(args: &SimulateArgs) -> anyhow::Result<DrapeOptions> {
-    let mut opts = match &args.simulator {
-        Some(path) => dataset::simulator::load_drape_options(path)?,
-        None => DrapeOptions::default(),
-    };
+    let mut opts = dataset::simulator::load_drape_options_or_default(args.simulator.as_deref())?;
     if let Some(skinning) = args.skinning {
         opts.skinning = skinning.into();
     }

@@ -17,6 +17,15 @@ pub fn load_drape_options(path: &Path) -> Result<DrapeOptions> {
         .map_err(|(field, message)| DatasetError::spec(path, field, message))
 }
 
+/// The drape options of the settings file at `path` ([`load_drape_options`]), or the
+/// simulator's defaults when there is none.
+pub fn load_drape_options_or_default(path: Option<&Path>) -> Result<DrapeOptions> {
+    match path {
+        Some(p) => load_drape_options(p),
+        None => Ok(DrapeOptions::default()),
+    }
+}
+
 impl SimulatorSpec {
     /// The drape options: the simulator's defaults with this spec's overrides. Errors are
     /// `(field, message)` with the field named as in the spec.

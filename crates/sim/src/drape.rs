@@ -96,14 +96,6 @@ impl Start {
             _ => None,
         }
     }
-
-    /// The name [`Start::from_name`] reads.
-    pub fn name(self) -> &'static str {
-        match self {
-            Start::Animate => "animate",
-            Start::Fitted => "fitted",
-        }
-    }
 }
 
 impl Default for DrapeOptions {

@@ -69,7 +69,7 @@ pub fn morph(
     };
     let mut sim = ClothSim::with_stretch_scale(&rest, &opts.cloth, &stretch_scale)?;
     sim.set_positions(&template.mesh.vertices)?;
-    let fitted = opts.start != Start::Animate;
+    let fitted = opts.start == Start::Fitted;
     let start_body = if fitted {
         &target.mesh
     } else {

@@ -206,13 +206,15 @@ pub fn spread(
         bodies: KeyedCache::new(2 * jobs + 4),
         morphs: KeyedCache::new(1),
     };
-    let mut chosen = chosen_samples(&plan, split, opts.per_garment);
-    for (samples, name) in chosen.iter_mut().zip(&garment_names) {
-        if !opts.garments.is_empty() && !opts.garments.iter().any(|g| g == name) {
-            samples.clear();
-        }
-    }
-    let total = 3 * chosen.iter().map(Vec::len).sum::<usize>() as u64;
+    // (garment index, its samples) of the garments measured.
+    let chosen: Vec<(usize, Vec<u64>)> = chosen_samples(&plan, split, opts.per_garment)
+        .into_iter()
+        .enumerate()
+        .filter(|(g, _)| {
+            opts.garments.is_empty() || opts.garments.contains(&plan.garments[*g].name)
+        })
+        .collect();
+    let total = 3 * chosen.iter().map(|(_, s)| s.len()).sum::<usize>() as u64;
     let (done, failed) = (AtomicU64::new(0), AtomicU64::new(0));
     let notify = |drapes: u64, failures: u64| {
         let done = done.fetch_add(drapes, Ordering::SeqCst) + drapes;
@@ -231,10 +233,7 @@ pub fn spread(
         .build()
         .map_err(|e| DatasetError::Invalid(format!("starting {jobs} threads: {e}")))?;
     let (mut garments, mut rows) = (Vec::new(), Vec::new());
-    for (g, samples) in chosen.iter().enumerate() {
-        if samples.is_empty() && !opts.garments.is_empty() {
-            continue;
-        }
+    for &(g, ref samples) in &chosen {
         let tg = Instant::now();
         let made: Vec<Result<SpreadRow>> = pool.install(|| {
             samples
