@@ -42,6 +42,10 @@ pub struct TrainArgs {
     /// Epochs to complete, instead of the recipe's (a cosine schedule then ends there).
     #[arg(long, value_name = "N")]
     pub epochs: Option<usize>,
+    /// A compute budget in CPU minutes of training, instead of the recipe's `[schedule]
+    /// minutes` (the cosine then ends there; a resumed run keeps the time it has used).
+    #[arg(long, value_name = "MINUTES")]
+    pub minutes: Option<f64>,
     /// Train on at most this many training samples (quick runs), instead of the recipe's.
     #[arg(long, value_name = "N")]
     pub max_samples: Option<usize>,
@@ -66,6 +70,10 @@ impl TrainArgs {
         if let Some(e) = self.epochs {
             recipe.schedule.epochs = e;
             command += &format!(" --epochs {e}");
+        }
+        if let Some(m) = self.minutes {
+            recipe.schedule.minutes = Some(m);
+            command += &format!(" --minutes {m}");
         }
         if let Some(n) = self.max_samples {
             recipe.drapes.max_samples = Some(n);
@@ -247,6 +255,7 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
     trainer.set_max_grad_norm(s.grad_clip)?;
     let batches_per_epoch = train.indices.len().div_ceil(s.batch) as u64;
     trainer.set_schedule(recipe.lr_schedule(batches_per_epoch)?);
+    trainer.set_budget(recipe.time_budget()?);
     trainer.set_checkpoint_every(checkpoint_every);
     trainer.set_training_set(&training_set_name(&data, &train.indices, recipe));
     trainer.set_recipe(record.clone());
@@ -305,9 +314,10 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
             )
         });
         bar.suspend(|| eprintln!(
-            "epoch {} ({:.1} s, lr {:.2e}): loss {:.3e} (vertex {:.3e} pen {:.3e} norm {:.3e} bend {:.3e}), grad norm {:.3e}{v}{}",
+            "epoch {} ({:.1} s, {:.1} CPU min in all, lr {:.2e}): loss {:.3e} (vertex {:.3e} pen {:.3e} norm {:.3e} bend {:.3e}), grad norm {:.3e}{v}{}",
             r.epoch,
             r.seconds,
+            r.train_cpu_s / 60.0,
             r.lr,
             r.train.total,
             r.train.vertex,
@@ -330,7 +340,8 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
 }
 
 /// Fails, naming the checkpoint `from`, when the run it belongs to was trained by another
-/// recipe than `recipe` (the epoch count aside: a run may be extended), or by none.
+/// recipe than `recipe` (the epoch count and budget aside: a run may be extended), or by
+/// none.
 fn check_same_recipe(
     stored: Option<&RecipeRecord>,
     recipe: &Recipe,
@@ -344,6 +355,7 @@ fn check_same_recipe(
     };
     let mut same_epochs = stored.recipe.clone();
     same_epochs.schedule.epochs = recipe.schedule.epochs;
+    same_epochs.schedule.minutes = recipe.schedule.minutes;
     if &same_epochs != recipe {
         bail!(
             "{}: the run was trained by another recipe ({}); resume it with that recipe or \

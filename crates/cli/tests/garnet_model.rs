@@ -124,7 +124,11 @@ fn train_resume_eval_and_drape() {
     );
     ok_v(train(&naive_recipe, &naive, &[]));
     let csv = std::fs::read_to_string(naive.join("metrics.csv")).unwrap();
-    assert!(csv.lines().next().unwrap().ends_with(",train_grad_norm"));
+    assert!(csv
+        .lines()
+        .next()
+        .unwrap()
+        .ends_with(",train_grad_norm,train_cpu_s"));
     let lr = |csv: &str, row: usize| -> f64 {
         let line = csv.lines().nth(row).unwrap();
         line.split(',').nth(2).unwrap().parse().unwrap()
@@ -877,10 +881,23 @@ fn train_takes_a_recipe_and_few_options() {
     assert!(options <= 10, "{options} options:\n{help}");
     assert!(help.contains("--recipe"), "{help}");
     // Every shipped recipe parses and names its garment and variant in its file name.
-    for entry in std::fs::read_dir(common::repo().join("recipes")).unwrap() {
-        let path = entry.unwrap().path();
+    let files = |dir: &str| {
+        std::fs::read_dir(common::repo().join(dir))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.is_file())
+            .collect::<Vec<_>>()
+    };
+    for path in files("recipes") {
         let recipe = model::Recipe::load(&path).unwrap();
         let name = format!("{}-{}.toml", recipe.garment, recipe.variant);
         assert_eq!(path.file_name().unwrap().to_str().unwrap(), name);
+    }
+    // The design benchmark's recipes all train for the same compute budget.
+    let bench = files("recipes/bench");
+    assert!(!bench.is_empty());
+    for path in bench {
+        let recipe = model::Recipe::load(&path).unwrap();
+        assert_eq!(recipe.schedule.minutes, Some(30.0), "{}", path.display());
     }
 }

@@ -12,6 +12,7 @@ use crate::frame::CanonicalFrame;
 use crate::local::{BodySampling, LocalIndices};
 use crate::tensors::{points_tensor, vec_tensor};
 use crate::topology::GarmentTopology;
+use crate::vertex_frame::VertexFrames;
 
 /// The body mesh connectivity shared by the samples of a dataset (all bodies have one
 /// topology): faces and unique edges, for the body normals and mean edge length that the
@@ -115,6 +116,9 @@ pub struct InputSpec {
     /// The template's vertices `[N]` (metres) when the network takes them as an input (see
     /// [`crate::GarNetConfig::rest_input`]).
     pub rest_input: Option<Vec<Vec3>>,
+    /// The template's neighbourhoods when the network works in each vertex's frame (see
+    /// [`crate::GarNetConfig::vertex_frames`]).
+    pub vertex_frames: Option<Arc<VertexFrames>>,
 }
 
 impl InputSpec {
@@ -213,11 +217,26 @@ impl InputSpec {
             let copies: Vec<&[Vec3]> = warped.iter().map(|_| r.as_slice()).collect();
             points_tensor(&copies, device)
         });
+        let frames = match &self.vertex_frames {
+            Some(f) => {
+                let mut flat = Vec::new();
+                for m in warped {
+                    for r in f.rotations(m)? {
+                        // The transpose's columns are r's rows: r row-major.
+                        flat.extend(r.transpose().to_cols_array());
+                    }
+                }
+                let n = warped.first().map_or(0, |m| m.len());
+                Some(vec_tensor(flat, [warped.len(), n, 9], device))
+            }
+            None => None,
+        };
         Ok(NetInputs {
             body_stream: points_tensor(&refs, device),
             local,
             contact,
             rest,
+            frames,
         })
     }
 }
@@ -243,6 +262,9 @@ pub struct NetInputs {
     pub contact: Option<Tensor<3>>,
     /// The template's vertices `[B,N,3]`, metres (see [`crate::GarNetConfig::rest_input`]).
     pub rest: Option<Tensor<3>>,
+    /// Each vertex's frame `[B,N,9]`: the rotation from the template to M (see
+    /// [`crate::vertex_frame`]), row-major (`[3r + c]` is row r, column c).
+    pub frames: Option<Tensor<3>>,
 }
 
 /// A batch of B samples as tensors on one device, sharing one garment topology.

@@ -24,6 +24,7 @@
 
 use std::collections::HashMap;
 use std::path::Path;
+use std::sync::Arc;
 
 use burn::optim::ModuleOptimizer;
 use burn::prelude::*;
@@ -43,7 +44,8 @@ use crate::garnet::GarNet;
 use crate::local::BodySampling;
 use crate::loss::LossConfig;
 use crate::recipe::{Recipe, RecipeRecord};
-use crate::schedule::CosineSchedule;
+use crate::schedule::{CosineSchedule, TimeBudget};
+use crate::vertex_frame::VertexFrames;
 
 /// The format name in a checkpoint's metadata.
 pub const FORMAT: &str = "garnet-model-2";
@@ -137,9 +139,10 @@ impl ModelSetup {
         self
     }
 
-    /// How samples become this network's inputs.
-    pub fn input_spec(&self) -> InputSpec {
-        InputSpec {
+    /// How samples become this network's inputs. Fails on a template with a face index out
+    /// of range (which [`ModelSetup::validate`] refuses).
+    pub fn input_spec(&self) -> Result<InputSpec> {
+        Ok(InputSpec {
             sampling: self.body_sampling.clone(),
             local: self
                 .config
@@ -156,7 +159,12 @@ impl ModelSetup {
                 .config
                 .rest_input
                 .then(|| self.template.vertices.clone()),
-        }
+            vertex_frames: self
+                .config
+                .vertex_frames
+                .then(|| VertexFrames::new(&self.template).map(Arc::new))
+                .transpose()?,
+        })
     }
 
     /// Fails when the body skinning is not one of [`BODY_SKINNINGS`], the template or the
@@ -211,6 +219,13 @@ pub struct TrainState {
     pub max_grad_norm: Option<f32>,
     /// Learning-rate schedule (`None`: the rate stays as set).
     pub schedule: Option<CosineSchedule>,
+    /// A compute budget that ends the run and sets its rate (see [`TimeBudget`]); it
+    /// overrides `schedule`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub budget: Option<TimeBudget>,
+    /// CPU time the run's training steps have used so far, over every sitting, seconds.
+    #[serde(default)]
+    pub train_cpu_s: f64,
     /// In a mid-epoch checkpoint, how far epoch `epoch + 1` has gone (see
     /// [`crate::trainer::MID_EPOCH_CHECKPOINT`]); `None` at an epoch's end.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -133,6 +133,12 @@ pub struct GarNetConfig {
     /// which vertex it is looking at whatever the pose. Off in the paper's networks.
     #[config(default = false)]
     pub rest_input: bool,
+    /// Our extension (not in the paper): the network predicts each vertex's translation in
+    /// the vertex's own frame (the rotation carrying the template's neighbourhood of the
+    /// vertex onto M's, see [`crate::vertex_frame`]), and the garment stream also takes the
+    /// direction of gravity in that frame. Off in the paper's networks.
+    #[config(default = false)]
+    pub vertex_frames: bool,
     /// Width of the global garment feature (a shared layer then max pooling over vertices).
     #[config(default = 256)]
     pub garment_global: usize,
@@ -239,6 +245,9 @@ impl GarNetConfig {
         }
         if self.rest_input {
             name.push_str(" +rest");
+        }
+        if self.vertex_frames {
+            name.push_str(" +frames");
         }
         name
     }

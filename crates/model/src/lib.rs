@@ -64,6 +64,7 @@ pub mod tensors;
 pub mod topology;
 pub mod train;
 pub mod trainer;
+pub mod vertex_frame;
 
 pub use alloc::tune_allocator;
 pub use batch::{Batch, BodyTopology, InputSpec, KnownBodies, NetInputs, Sample};
@@ -75,12 +76,13 @@ pub use frame::CanonicalFrame;
 pub use garnet::GarNet;
 pub use init::LEAKY_SLOPE;
 pub use local::{BodySampling, LocalIndices};
-pub use loss::{garnet_loss, LossConfig, LossTerms, VertexLoss, LOSS_UNITS_PER_METRE};
+pub use loss::{garnet_loss, LossConfig, LossTerms, NormalLoss, VertexLoss, LOSS_UNITS_PER_METRE};
 pub use recipe::{Recipe, RecipeRecord};
-pub use schedule::CosineSchedule;
+pub use schedule::{CosineSchedule, TimeBudget};
 pub use topology::{GarmentTopology, TopologyTensors};
 pub use train::{adam, evaluate_batch, train_step, Evaluation, StepReport, PAPER_LEARNING_RATE};
 pub use trainer::{EpochReport, Trainer, Validation};
+pub use vertex_frame::VertexFrames;
 
 /// burn's optimiser type used for GarNet (Adam).
 pub use burn::optim::ModuleOptimizer as Optimizer;

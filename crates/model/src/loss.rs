@@ -10,7 +10,10 @@
 //! - `L_pen = 1/N sum_j 1{|G^P_j - G^G_j| < d_tol} ReLU(-n_i . (G^P_j - (B_i + 0.2 e n_i)))`
 //!   (centimetres), with i the body vertex nearest to G^P_j (found on the CPU at every step),
 //!   n_i its unit normal, e the body's mean edge length and d_tol = 0.05 m (5 cm);
-//! - `L_norm = 1/F sum_f (1 - F^G_f . F^P_f)^2` over unit face normals (no unit);
+//! - `L_norm = 1/F sum_f (1 - F^G_f . F^P_f)^2` over unit face normals (no unit), the
+//!   paper's; or with [`NormalLoss::Tilt`] `1/F sum_f s_f |F^G_f - F^P_f|` (centimetres),
+//!   where `s_f = sqrt(2 area)` of the label's face: how far a face's corners move when it
+//!   tilts (a tilt of angle t moves them about `s_f t`), a length like the other terms';
 //! - `L_bend = 1/|N2| sum_{i,k} | |G^P_i - G^P_k| - |G^G_i - G^G_k| |` over vertex pairs two
 //!   edges apart (centimetres).
 //!
@@ -56,6 +59,42 @@ pub struct LossConfig {
     /// How L_vertex measures each vertex's distance to its label.
     #[config(default = "VertexLoss::Squared")]
     pub vertex_loss: VertexLoss,
+    /// How L_norm measures a face's turn from its label's.
+    #[config(default = "NormalLoss::Paper")]
+    pub normal_loss: NormalLoss,
+}
+
+/// How L_norm measures the turn of each face's normal from its label's.
+#[derive(Config, Debug, Copy, PartialEq, Eq)]
+pub enum NormalLoss {
+    /// The paper's `(1 - cos t)^2` (no unit): about `t^4 / 4` for a turn of t radians, so
+    /// its gradient vanishes at the 10-25 degree errors networks make, and beside L_vertex
+    /// in centimetres it barely steers training.
+    Paper,
+    /// The corners' displacement of the tilt, `s_f |F^G - F^P|` = `s_f 2 sin(t/2)`
+    /// (centimetres): linear in the angle, in the unit of L_vertex.
+    Tilt,
+}
+
+impl NormalLoss {
+    /// Lower-case name: `paper` or `tilt`.
+    pub fn name(self) -> &'static str {
+        match self {
+            NormalLoss::Paper => "paper",
+            NormalLoss::Tilt => "tilt",
+        }
+    }
+
+    /// Parses [`NormalLoss::name`].
+    pub fn parse(s: &str) -> Result<NormalLoss> {
+        match s {
+            "paper" => Ok(NormalLoss::Paper),
+            "tilt" => Ok(NormalLoss::Tilt),
+            _ => Err(ModelError::InvalidInput(format!(
+                "unknown L_norm kind {s:?} (paper or tilt)"
+            ))),
+        }
+    }
 }
 
 /// The loss's length unit, units per metre: L_vertex is in cm^2 (or cm), L_pen and L_bend
@@ -112,7 +151,7 @@ pub struct LossTerms {
     pub vertex: f32,
     /// L_pen, loss units (cm).
     pub pen: f32,
-    /// L_norm, no unit.
+    /// L_norm: no unit ([`NormalLoss::Paper`]) or loss units, cm ([`NormalLoss::Tilt`]).
     pub norm: f32,
     /// L_bend, loss units (cm).
     pub bend: f32,
@@ -216,6 +255,20 @@ pub fn normal_loss(pred: Tensor<3>, target: Tensor<3>, faces: &[Tensor<1, Int>; 
     ((fp * fg).sum_dim(2).neg() + 1.0).square().mean()
 }
 
+/// L_norm as a tilt ([`NormalLoss::Tilt`]): mean over the B*F faces of
+/// `sqrt(2 area(F^G)) |F^G - F^P|`, metres. `pred`, `target` `[B,N,3]` metres.
+pub fn tilt_loss(pred: Tensor<3>, target: Tensor<3>, faces: &[Tensor<1, Int>; 3]) -> Tensor<1> {
+    let fp = face_normals(pred, faces);
+    let v0 = gather_rows(target.clone(), &faces[0]);
+    let v1 = gather_rows(target.clone(), &faces[1]);
+    let v2 = gather_rows(target, &faces[2]);
+    let cross = (v1 - v0.clone()).cross(v2 - v0, 2).detach();
+    let twice_area = (cross.clone().square().sum_dim(2) + SQRT_EPS).sqrt();
+    let fg = cross / twice_area.clone();
+    let turn = ((fp - fg).square().sum_dim(2) + SQRT_EPS).sqrt();
+    (turn * twice_area.sqrt()).mean()
+}
+
 /// Lengths `[B,P,1]` between the vertices of each pair (metres).
 fn pair_lengths(v: Tensor<3>, pairs: &[Tensor<1, Int>; 2]) -> Tensor<3> {
     let a = gather_rows(v.clone(), &pairs[0]);
@@ -306,6 +359,7 @@ pub fn garnet_loss(
         .ok_or_else(|| ModelError::InvalidInput("the loss needs a batch with targets".into()))?;
     let device = pred.device();
     let [b, n, _] = pred.dims();
+    let unit = LOSS_UNITS_PER_METRE;
     let pred_points = read_points(pred.clone().detach())?;
     let (nearest, close) =
         penetration_matches(&pred_points, targets, &batch.body_index, cfg.d_tol as f32)?;
@@ -319,9 +373,11 @@ pub fn garnet_loss(
         vec_tensor(close, [b, n, 1], &device),
         cfg.pen_push,
     );
-    let norm = normal_loss(pred.clone(), target.clone(), &topo.faces);
+    let norm = match cfg.normal_loss {
+        NormalLoss::Paper => normal_loss(pred.clone(), target.clone(), &topo.faces),
+        NormalLoss::Tilt => tilt_loss(pred.clone(), target.clone(), &topo.faces) * unit,
+    };
     let bend = bending_loss(pred, target, &topo.bend_pairs);
-    let unit = LOSS_UNITS_PER_METRE;
     let vertex = vertex * unit.powf(cfg.vertex_loss.power());
     let pen = pen * unit;
     let bend = bend * unit;
@@ -403,6 +459,7 @@ mod tests {
             canonical_rest: None,
             contact_faces: None,
             rest_input: None,
+            vertex_frames: None,
         };
         let b = Batch::new(&[sample], &topo, &spec, device).unwrap();
         (b, topo.to_device(device))
@@ -433,6 +490,22 @@ mod tests {
         close(
             read_scalar(normal_loss(pred.clone(), target.clone(), &topo.faces)).unwrap(),
             tilt,
+        );
+        // As a tilt: each face turns 45 degrees, |F^G - F^P| = 2 sin(22.5 deg), and each of
+        // the label's faces has sqrt(2 area) = 1 m.
+        let turn = 2.0 * (std::f64::consts::PI / 8.0).sin();
+        close(
+            read_scalar(tilt_loss(pred.clone(), target.clone(), &topo.faces)).unwrap(),
+            turn,
+        );
+        let tilt_cfg = LossConfig::new().with_normal_loss(NormalLoss::Tilt);
+        let t = garnet_loss(pred.clone(), &b, &topo, &tilt_cfg)
+            .unwrap()
+            .values()
+            .unwrap();
+        assert!(
+            ((t.norm as f64 - 100.0 * turn) / (100.0 * turn)).abs() < 1e-5,
+            "{t:?}"
         );
         // Pair (1,3): |(1,-1.5,0)| - |(1,-1,0)| = sqrt(3.25) - sqrt(2).
         let bend = 3.25f64.sqrt() - 2f64.sqrt();
@@ -587,6 +660,7 @@ mod tests {
             canonical_rest: None,
             contact_faces: None,
             rest_input: None,
+            vertex_frames: None,
         };
         let cfg = LossConfig::new().with_vertex_loss(vertex_loss);
         let loss_at = |p: &[Vec3]| -> f64 {

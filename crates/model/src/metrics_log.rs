@@ -3,14 +3,15 @@
 //! ```text
 //! epoch,step,lr,seconds,train_samples,train_total,train_vertex,train_pen,train_norm,
 //! train_bend,val_samples,val_total,val_vertex,val_pen,val_norm,val_bend,val_e_dist_cm,
-//! val_e_norm_deg,best,train_grad_norm
+//! val_e_norm_deg,best,train_grad_norm,train_cpu_s
 //! ```
 //!
 //! Loss terms in the loss's units (vertex cm^2, or cm with `VertexLoss::Distance`; pen and
 //! bend cm; norm none);
 //! the `val_*` fields are empty for an epoch without validation; `best` is 1 when the epoch
 //! wrote `best.garnet`; `train_grad_norm` is the epoch's mean joint gradient norm before
-//! clipping. Appending a row drops any rows of that epoch or later (a resumed run rewrites
+//! clipping; `train_cpu_s` the CPU time the run's training steps have
+//! used so far, seconds (what a compute budget counts). Appending a row drops any rows of that epoch or later (a resumed run rewrites
 //! the epochs after its checkpoint). A log whose header is not [`HEADER`] is refused. The file is rewritten atomically (temporary file, rename).
 
 use std::path::PathBuf;
@@ -22,7 +23,7 @@ use crate::trainer::Validation;
 /// The CSV header line.
 pub const HEADER: &str = "epoch,step,lr,seconds,train_samples,train_total,train_vertex,\
 train_pen,train_norm,train_bend,val_samples,val_total,val_vertex,val_pen,val_norm,val_bend,\
-val_e_dist_cm,val_e_norm_deg,best,train_grad_norm";
+val_e_dist_cm,val_e_norm_deg,best,train_grad_norm,train_cpu_s";
 
 /// One epoch's row.
 #[derive(Clone, Debug, PartialEq)]
@@ -45,6 +46,8 @@ pub struct MetricsRow {
     pub validation: Option<Validation>,
     /// Whether the epoch wrote the best checkpoint.
     pub is_best: bool,
+    /// CPU time of the run's training steps so far, seconds.
+    pub train_cpu_s: f64,
 }
 
 impl MetricsRow {
@@ -79,7 +82,7 @@ impl MetricsRow {
             None => s.push_str(",,,,,,,,"),
         }
         s.push_str(if self.is_best { "1," } else { "0," });
-        s.push_str(&self.grad_norm.to_string());
+        s.push_str(&format!("{},{:.1}", self.grad_norm, self.train_cpu_s));
         s
     }
 }
@@ -157,6 +160,7 @@ mod tests {
                 samples: 2,
             }),
             is_best: val,
+            train_cpu_s: 12.34,
         }
     }
 
@@ -177,8 +181,8 @@ mod tests {
         assert!(lines.iter().all(|l| l.split(',').count() == cols));
         assert!(lines[1].starts_with("1,10,0.001,1.500,8,0.5,0.25,0,0.1,0.2,2,"));
         assert!(lines[2].starts_with("2,20,"));
-        assert!(lines[2].ends_with(",1.25,9.5,1,2.5"));
-        assert!(row(4, false).to_csv().ends_with(",,,,,,,,0,2.5"));
+        assert!(lines[2].ends_with(",1.25,9.5,1,2.5,12.3"));
+        assert!(row(4, false).to_csv().ends_with(",,,,,,,,0,2.5,12.3"));
     }
 
     #[test]

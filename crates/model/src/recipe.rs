@@ -15,6 +15,7 @@
 //! [loss]                      # weights of the four terms; L_vertex squared or the distance
 //! vertex = 1.0
 //! vertex_loss = "squared"
+//! normal_loss = "paper"       # or "tilt": L_norm in centimetres, linear in the angle
 //!
 //! [schedule]
 //! epochs = 30
@@ -24,6 +25,8 @@
 //! cosine_to = 1e-5            # then along half a cosine to this rate at `epochs`
 //! per_step = true             # the cosine followed step by step, not epoch by epoch
 //! grad_clip = 200.0
+//! # minutes = 30.0          # or a compute budget: stop after 30 CPU minutes of training
+//! # warmup_minutes = 1.0    # steps, the cosine over the budget (epochs is then a cap)
 //!
 //! [drapes]                    # which training drapes to use (validation keeps all)
 //! at_rest = true
@@ -36,8 +39,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::config::{GarNetConfig, Variant};
 use crate::error::{ModelError, Result};
-use crate::loss::{LossConfig, VertexLoss};
-use crate::schedule::CosineSchedule;
+use crate::loss::{LossConfig, NormalLoss, VertexLoss};
+use crate::schedule::{CosineSchedule, TimeBudget};
 
 /// The recipe format this build reads and writes.
 pub const RECIPE_FORMAT: u32 = 1;
@@ -104,6 +107,9 @@ pub struct NetworkRecipe {
     /// [`GarNetConfig::rest_input`] (default false: the paper's inputs).
     #[serde(default)]
     pub rest_input: bool,
+    /// [`GarNetConfig::vertex_frames`] (default false: the paper's world-frame output).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub vertex_frames: bool,
     /// [`GarNetConfig::seed`]: the initial parameters' seed.
     #[serde(default)]
     pub seed: u64,
@@ -123,6 +129,8 @@ pub struct LossRecipe {
     pub bend: f64,
     /// `squared` (the paper's) or `distance` (see [`VertexLoss`]).
     pub vertex_loss: String,
+    /// `paper` (the paper's) or `tilt` (see [`NormalLoss`]).
+    pub normal_loss: String,
 }
 
 impl Default for LossRecipe {
@@ -134,6 +142,7 @@ impl Default for LossRecipe {
             norm: paper.norm,
             bend: paper.bend,
             vertex_loss: paper.vertex_loss.name().into(),
+            normal_loss: paper.normal_loss.name().into(),
         }
     }
 }
@@ -165,10 +174,23 @@ pub struct ScheduleRecipe {
     /// Seed of the per-epoch shuffle (default 0).
     #[serde(default)]
     pub seed: u64,
+    /// A compute budget, CPU minutes of training steps (every thread of the process; see
+    /// [`crate::TimeBudget`]): the run stops when it is used, and the rate is held for
+    /// `warmup_minutes`, then follows the cosine to `cosine_to` over the rest of the budget
+    /// (step by step). `epochs` stays a cap. None: the run is measured in epochs.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub minutes: Option<f64>,
+    /// With `minutes`: CPU minutes at `lr` before the cosine starts (default 0).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub warmup_minutes: f64,
     /// Inside an epoch, write a resumable checkpoint every this many minutes (default 10;
     /// 0: never).
     #[serde(default = "default_checkpoint_minutes")]
     pub checkpoint_minutes: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 fn default_batch() -> usize {
@@ -266,7 +288,17 @@ impl Recipe {
                 s.lr, s.cosine_to
             ));
         }
-        if s.cosine_to.is_some() && s.warmup_epochs >= s.epochs {
+        if s.minutes.is_some() {
+            if s.warmup_epochs != 0 || s.per_step {
+                return bad("schedule: a budget in minutes takes warmup_minutes, not \
+                            warmup_epochs or per_step (it always goes step by step)"
+                    .into());
+            }
+            self.time_budget()?;
+        } else if s.warmup_minutes != 0.0 {
+            return bad("schedule: warmup_minutes needs a budget (minutes)".into());
+        }
+        if s.minutes.is_none() && s.cosine_to.is_some() && s.warmup_epochs >= s.epochs {
             return bad(format!(
                 "schedule: the cosine needs warmup_epochs ({}) below epochs ({})",
                 s.warmup_epochs, s.epochs
@@ -312,6 +344,7 @@ impl Recipe {
         let mut c = GarNetConfig::new(self.variant()?)
             .with_body_contact(n.body_contact)
             .with_rest_input(n.rest_input)
+            .with_vertex_frames(n.vertex_frames)
             .with_seed(n.seed);
         if let Some(v) = n.body_subsample {
             c.body_subsample = v;
@@ -348,15 +381,16 @@ impl Recipe {
             .with_pen(l.pen)
             .with_norm(l.norm)
             .with_bend(l.bend)
-            .with_vertex_loss(VertexLoss::parse(&l.vertex_loss)?))
+            .with_vertex_loss(VertexLoss::parse(&l.vertex_loss)?)
+            .with_normal_loss(NormalLoss::parse(&l.normal_loss)?))
     }
 
     /// The learning-rate schedule of a run whose epochs have `steps_per_epoch` steps: `None`
-    /// for a constant rate, else `lr` until `warmup_epochs`, then the cosine to `cosine_to`
-    /// at `epochs`.
+    /// for a constant rate or a budget in minutes ([`Recipe::time_budget`]), else `lr` until
+    /// `warmup_epochs`, then the cosine to `cosine_to` at `epochs`.
     pub fn lr_schedule(&self, steps_per_epoch: u64) -> Result<Option<CosineSchedule>> {
         let s = &self.schedule;
-        let Some(end) = s.cosine_to else {
+        let (Some(end), None) = (s.cosine_to, s.minutes) else {
             return Ok(None);
         };
         let cosine = CosineSchedule::new(s.lr, end, s.warmup_epochs, s.epochs)?;
@@ -365,6 +399,17 @@ impl Recipe {
         } else {
             cosine
         }))
+    }
+}
+
+impl Recipe {
+    /// The compute budget of `[schedule] minutes` (`None` without one): `lr` for
+    /// `warmup_minutes`, then the cosine to `cosine_to` (or `lr` throughout without it).
+    pub fn time_budget(&self) -> Result<Option<TimeBudget>> {
+        let s = &self.schedule;
+        s.minutes
+            .map(|m| TimeBudget::new(m, s.warmup_minutes, s.lr, s.cosine_to.unwrap_or(s.lr)))
+            .transpose()
     }
 }
 
@@ -439,6 +484,10 @@ max_strain_pct = 5.0
             (EXAMPLE.replace("format = 1\n", ""), "format missing"),
             (EXAMPLE.replace("\"local\"", "\"huge\""), "variant"),
             (EXAMPLE.replace("\"distance\"", "\"cubed\""), "L_vertex"),
+            (
+                EXAMPLE.replace("vertex = 2.0", "vertex = 2.0\nnormal_loss = \"cos\""),
+                "L_norm",
+            ),
             (EXAMPLE.replace("epochs = 30", "epochs = 0"), "epochs"),
             (
                 EXAMPLE.replace("warmup_epochs = 1", "warmup_epochs = 30"),
@@ -457,6 +506,41 @@ max_strain_pct = 5.0
         ];
         for (text, want) in cases {
             let err = Recipe::parse(&text).unwrap_err().to_string();
+            assert!(err.contains(want), "{want}: {err}");
+        }
+    }
+
+    #[test]
+    fn a_budget_in_minutes_replaces_the_epoch_schedule() {
+        let text = EXAMPLE
+            .replace(
+                "warmup_epochs = 1\n",
+                "minutes = 30.0\nwarmup_minutes = 1.5\n",
+            )
+            .replace("per_step = true\n", "");
+        let r = Recipe::parse(&text).unwrap();
+        assert_eq!(r.lr_schedule(100).unwrap(), None);
+        let b = r.time_budget().unwrap().unwrap();
+        assert_eq!(b, TimeBudget::new(30.0, 1.5, 3e-4, 1e-5).unwrap());
+        assert_eq!(Recipe::parse(&r.to_toml()).unwrap(), r);
+        assert_eq!(Recipe::parse(EXAMPLE).unwrap().time_budget().unwrap(), None);
+        let refused = [
+            (text.replace("minutes = 30.0", "minutes = 0.0"), "budget"),
+            (
+                text.replace("warmup_minutes = 1.5", "warmup_minutes = 30.0"),
+                "warm-up",
+            ),
+            (
+                text.replace("minutes = 30.0\n", "per_step = true\n"),
+                "needs a budget",
+            ),
+            (
+                text.replace("batch = 1", "batch = 1\nper_step = true"),
+                "per_step",
+            ),
+        ];
+        for (t, want) in refused {
+            let err = Recipe::parse(&t).unwrap_err().to_string();
             assert!(err.contains(want), "{want}: {err}");
         }
     }

@@ -1,4 +1,5 @@
-//! Learning-rate schedules over epochs.
+//! Learning-rate schedules: over epochs ([`CosineSchedule`]) or over a compute budget
+//! ([`TimeBudget`]).
 
 use serde::{Deserialize, Serialize};
 
@@ -87,6 +88,64 @@ impl CosineSchedule {
     }
 }
 
+/// A fixed compute budget: training stops once its steps have used `minutes` of CPU time
+/// (of every thread of the process, so a run on one thread gets `minutes` of one core), and
+/// the learning rate follows the budget: `start_lr` for `warmup_minutes`, then half a cosine
+/// to `end_lr` at the budget's end. Validation and checkpoints do not count. Two designs
+/// compared on the same budget have had the same compute, whatever their step cost.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TimeBudget {
+    /// The budget, CPU minutes (> 0).
+    pub minutes: f64,
+    /// CPU minutes at `start_lr` before the cosine starts (>= 0, < `minutes`).
+    pub warmup_minutes: f64,
+    /// Learning rate at the start.
+    pub start_lr: f64,
+    /// Learning rate at the budget's end (equal to `start_lr`: a constant rate).
+    pub end_lr: f64,
+}
+
+impl TimeBudget {
+    /// A budget; fails when a rate is not a positive number or the minutes are out of range.
+    pub fn new(minutes: f64, warmup_minutes: f64, start_lr: f64, end_lr: f64) -> Result<Self> {
+        let rate_ok = |r: f64| r.is_finite() && r > 0.0;
+        if !rate_ok(start_lr) || !rate_ok(end_lr) {
+            return Err(ModelError::InvalidInput(format!(
+                "learning rates must be > 0, got {start_lr} and {end_lr}"
+            )));
+        }
+        if !(minutes.is_finite() && minutes > 0.0) {
+            return Err(ModelError::InvalidInput(format!(
+                "the budget must be > 0 minutes, got {minutes}"
+            )));
+        }
+        if !(warmup_minutes.is_finite() && (0.0..minutes).contains(&warmup_minutes)) {
+            return Err(ModelError::InvalidInput(format!(
+                "the warm-up must be >= 0 and under the budget ({minutes} minutes), got \
+                 {warmup_minutes}"
+            )));
+        }
+        Ok(TimeBudget {
+            minutes,
+            warmup_minutes,
+            start_lr,
+            end_lr,
+        })
+    }
+
+    /// The learning rate after `cpu_s` seconds of training.
+    pub fn lr(&self, cpu_s: f64) -> f64 {
+        let (warm, all) = (self.warmup_minutes * 60.0, self.minutes * 60.0);
+        let t = ((cpu_s - warm).max(0.0) / (all - warm)).min(1.0);
+        self.end_lr + (self.start_lr - self.end_lr) * 0.5 * (1.0 + (std::f64::consts::PI * t).cos())
+    }
+
+    /// Whether `cpu_s` seconds of training have used the budget.
+    pub fn spent(&self, cpu_s: f64) -> bool {
+        cpu_s >= self.minutes * 60.0
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -135,5 +194,27 @@ mod tests {
         assert!(CosineSchedule::new(0.0, 1e-5, 0, 10).is_err());
         assert!(CosineSchedule::new(1e-3, f64::NAN, 0, 10).is_err());
         assert!(CosineSchedule::new(1e-3, 1e-5, 10, 10).is_err());
+    }
+
+    #[test]
+    fn a_budget_holds_then_falls_along_the_cosine_and_ends() {
+        let b = TimeBudget::new(10.0, 2.0, 1e-3, 1e-5).unwrap();
+        assert_eq!(b.lr(0.0), 1e-3);
+        assert_eq!(b.lr(120.0), 1e-3);
+        assert!((b.lr(360.0) - (1e-5 + 0.5 * (1e-3 - 1e-5))).abs() < 1e-12);
+        assert!((b.lr(600.0) - 1e-5).abs() < 1e-15);
+        assert!((b.lr(900.0) - 1e-5).abs() < 1e-15);
+        assert!(!b.spent(599.9) && b.spent(600.0));
+        let flat = TimeBudget::new(10.0, 0.0, 3e-4, 3e-4).unwrap();
+        assert_eq!(flat.lr(300.0), 3e-4);
+    }
+
+    #[test]
+    fn refuses_bad_budgets() {
+        assert!(TimeBudget::new(0.0, 0.0, 1e-3, 1e-5).is_err());
+        assert!(TimeBudget::new(f64::NAN, 0.0, 1e-3, 1e-5).is_err());
+        assert!(TimeBudget::new(10.0, 10.0, 1e-3, 1e-5).is_err());
+        assert!(TimeBudget::new(10.0, -1.0, 1e-3, 1e-5).is_err());
+        assert!(TimeBudget::new(10.0, 1.0, 0.0, 1e-5).is_err());
     }
 }

@@ -12,6 +12,7 @@ use burn::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::batch::{Batch, InputSpec, Sample};
+use crate::bench::process_cpu_ms;
 use crate::checkpoint::{load_checkpoint, save_checkpoint, ModelSetup, TrainState};
 use crate::drape::Draper;
 use crate::epoch_progress::EpochProgress;
@@ -20,7 +21,7 @@ use crate::garnet::GarNet;
 use crate::loss::{LossConfig, LossTerms};
 use crate::metrics_log::{MetricsLog, MetricsRow};
 use crate::recipe::RecipeRecord;
-use crate::schedule::CosineSchedule;
+use crate::schedule::{CosineSchedule, TimeBudget};
 use crate::topology::{GarmentTopology, TopologyTensors};
 use crate::train::{adam, evaluate_batch, train_step, StepReport};
 
@@ -73,6 +74,9 @@ pub struct EpochReport {
     pub is_best: bool,
     /// Wall time of the epoch including validation and checkpoints, seconds.
     pub seconds: f64,
+    /// CPU time the run's training steps have used so far, every sitting, seconds (what a
+    /// [`TimeBudget`] counts).
+    pub train_cpu_s: f64,
 }
 
 /// Trains one network: holds it (on an autodiff device), its Adam optimiser, its setup and
@@ -167,7 +171,7 @@ impl Trainer {
         let topo = topology.to_device(&device);
         let topo_valid = topology.to_device(&device.clone().inner());
         setup.validate()?;
-        let spec = setup.input_spec();
+        let spec = setup.input_spec()?;
         Ok(Trainer {
             model,
             optim,
@@ -304,6 +308,21 @@ impl Trainer {
         };
     }
 
+    /// Trains for `budget` (`None`: by epochs only): [`Trainer::fit`] stops once the steps
+    /// have used its CPU time, over every sitting, and the rate follows it, overriding any
+    /// [`Trainer::set_schedule`]. A resumed run keeps the time it has used, so a larger
+    /// budget extends it.
+    pub fn set_budget(&mut self, budget: Option<TimeBudget>) {
+        self.state.budget = budget;
+    }
+
+    /// Whether the run has a budget and has used it.
+    pub fn budget_spent(&self) -> bool {
+        self.state
+            .budget
+            .is_some_and(|b| b.spent(self.state.train_cpu_s))
+    }
+
     /// The loss configuration.
     pub fn loss_config(&self) -> &LossConfig {
         &self.loss
@@ -380,18 +399,26 @@ impl Trainer {
         E: Display,
     {
         let (start, before) = (Instant::now(), progress.seconds);
+        let clock = CpuClock::start(self.state.train_cpu_s);
         let mut saved = start;
         for batch in batches {
+            if self.budget_spent() {
+                break;
+            }
             let samples = batch.map_err(|e| ModelError::Data(e.to_string()))?;
             if samples.is_empty() {
                 progress.add_empty();
                 continue;
             }
-            // The schedule's rate for this step (the epoch's rate unless it goes step by step).
-            if let Some(s) = self.state.schedule {
+            // The budget's or the schedule's rate for this step (the schedule's is the
+            // epoch's rate unless it goes step by step).
+            if let Some(b) = self.state.budget {
+                self.lr = b.lr(self.state.train_cpu_s);
+            } else if let Some(s) = self.state.schedule {
                 self.lr = s.lr_of_step(self.state.epoch, progress.batches);
             }
             let report = self.step(&samples)?;
+            self.state.train_cpu_s = clock.seconds();
             progress.add(&report, samples.len());
             progress.seconds = before + start.elapsed().as_secs_f64();
             let due = self.checkpoint_every.is_some_and(|e| saved.elapsed() >= e);
@@ -531,6 +558,7 @@ impl Trainer {
             grad_norm,
             validation,
             is_best,
+            train_cpu_s: self.state.train_cpu_s,
         };
         MetricsLog::new(out_dir.join(METRICS_LOG)).append(&row)?;
         Ok(EpochReport {
@@ -542,10 +570,12 @@ impl Trainer {
             validation,
             is_best,
             seconds,
+            train_cpu_s: self.state.train_cpu_s,
         })
     }
 
-    /// Runs epochs until `epochs` are completed (counting those of a resumed checkpoint):
+    /// Runs epochs until `epochs` are completed (counting those of a resumed checkpoint), or
+    /// until the [`Trainer::set_budget`] budget is used (its last epoch then ends early):
     /// `train(epoch, skip)` gives the training batches of each epoch (shuffle there) without
     /// its first `skip`, which a mid-epoch checkpoint trained already (0 otherwise);
     /// `valid()` the validation batches; `on_epoch` sees each report. Returns the reports of
@@ -585,7 +615,7 @@ impl Trainer {
             }
         }
         let mut reports = Vec::new();
-        while self.state.epoch < epochs {
+        while self.state.epoch < epochs && !self.budget_spent() {
             let epoch = self.state.epoch;
             let skip = self.state.partial.as_ref().map_or(0, |p| p.batches);
             let v = valid.as_mut().map(|f| f());
@@ -603,5 +633,33 @@ impl Trainer {
             out_dir.join(BEST_CHECKPOINT),
             out_dir.join(METRICS_LOG),
         )
+    }
+}
+
+/// The training time of a run: CPU time of the process since [`CpuClock::start`] plus what
+/// earlier sittings used; wall time where the process's CPU time cannot be read.
+struct CpuClock {
+    before_s: f64,
+    cpu0_ms: Option<f64>,
+    wall0: Instant,
+}
+
+impl CpuClock {
+    /// A clock that has already counted `before_s` seconds.
+    fn start(before_s: f64) -> CpuClock {
+        CpuClock {
+            before_s,
+            cpu0_ms: process_cpu_ms(),
+            wall0: Instant::now(),
+        }
+    }
+
+    /// Seconds counted so far.
+    fn seconds(&self) -> f64 {
+        let now = match (self.cpu0_ms, process_cpu_ms()) {
+            (Some(a), Some(b)) => (b - a) / 1e3,
+            _ => self.wall0.elapsed().as_secs_f64(),
+        };
+        self.before_s + now
     }
 }

@@ -48,7 +48,7 @@ fn every_variant_outputs_b_n_3() {
         let n = s.template.num_vertices();
         let model = s.config.init(&device).unwrap();
         let topo = GarmentTopology::from_mesh(&s.template).unwrap();
-        let batch = Batch::new(&samples(&s, 2), &topo, &s.input_spec(), &device).unwrap();
+        let batch = Batch::new(&samples(&s, 2), &topo, &s.input_spec().unwrap(), &device).unwrap();
         assert_eq!(batch.inputs.local.is_some(), variant == Variant::Local);
         let out = model
             .forward(
@@ -85,7 +85,7 @@ fn local_variant_needs_its_tables() {
     let s = setup(Variant::Local, 60);
     let model = s.config.init(&device).unwrap();
     let topo = GarmentTopology::from_mesh(&s.template).unwrap();
-    let batch = Batch::new(&samples(&s, 1), &topo, &s.input_spec(), &device).unwrap();
+    let batch = Batch::new(&samples(&s, 1), &topo, &s.input_spec().unwrap(), &device).unwrap();
     let mut inputs = batch.inputs.clone();
     inputs.local = None;
     let err = model
@@ -232,7 +232,7 @@ fn drapes_on_the_host_match_the_tensor_ops() {
             .collect();
         let run = |device: &Device| {
             let model = setup.config.init(device).unwrap();
-            let batch = Batch::new(&samples, &topo, &setup.input_spec(), device).unwrap();
+            let batch = Batch::new(&samples, &topo, &setup.input_spec().unwrap(), device).unwrap();
             let pred = model.forward(&batch.inputs, batch.warped.clone(), &topo.to_device(device));
             model::tensors::read_points(pred.unwrap()).unwrap()
         };
@@ -253,13 +253,14 @@ fn extended_network_takes_its_inputs_and_only_it() {
     let (body, body_topo) = meshed_body();
     let cfg = GarNetConfig::tiny(Variant::Local)
         .with_body_contact(true)
-        .with_rest_input(true);
+        .with_rest_input(true)
+        .with_vertex_frames(true);
     let template = tube_garment(60);
     let setup = ModelSetup::new(cfg.clone(), template.clone(), &body).unwrap();
     assert!(setup.validate().is_err(), "no body faces");
     let setup = setup.with_body_faces(body_topo.faces.clone()).unwrap();
     let model = setup.config.init(&device).unwrap();
-    assert!(model.body_contact && model.rest_input);
+    assert!(model.body_contact && model.rest_input && model.vertex_frames);
     let sample = Sample::new(
         body.clone(),
         &body_topo,
@@ -272,7 +273,7 @@ fn extended_network_takes_its_inputs_and_only_it() {
     .unwrap();
     let topo = GarmentTopology::from_mesh(&template).unwrap();
     let topo_t = topo.to_device(&device);
-    let batch = Batch::new(&[sample], &topo, &setup.input_spec(), &device).unwrap();
+    let batch = Batch::new(&[sample], &topo, &setup.input_spec().unwrap(), &device).unwrap();
     let contact = batch.inputs.contact.clone().expect("contact features");
     // M is the template, so the canonical frame is the identity.
     let normals = geom::normals::vertex_normals(&body, &body_topo.faces);
@@ -289,10 +290,50 @@ fn extended_network_takes_its_inputs_and_only_it() {
     assert!(worst < 1e-3, "{worst}");
     let rest = model::tensors::read_points(batch.inputs.rest.clone().unwrap()).unwrap();
     assert_eq!(rest[0], template.vertices);
+    // M is the template: every vertex frame is the identity.
+    let frames = batch.inputs.frames.clone().expect("vertex frames");
+    assert_eq!(frames.dims(), [1, 60, 9]);
+    let identity = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+    for (k, v) in model::tensors::read_f32(frames.clone())
+        .unwrap()
+        .iter()
+        .enumerate()
+    {
+        assert!((v - identity[k % 9]).abs() < 1e-4, "entry {k}: {v}");
+    }
     let run =
         |m: &model::GarNet, inputs: &NetInputs| m.forward(inputs, batch.warped.clone(), &topo_t);
     let pred = model::tensors::read_points(run(&model, &batch.inputs).unwrap()).unwrap();
-    // Each extra input left out (bit 0 contact, 1 template vertices).
+    // Frames turned about gravity leave the gravity input as it was, so the translations
+    // (in each vertex's frame) turn with them.
+    let yaw = glam::Mat3::from_rotation_y(0.8);
+    let turned: Vec<f32> = model::tensors::read_f32(frames)
+        .unwrap()
+        .chunks(9)
+        .flat_map(|r| {
+            let r = glam::Mat3::from_cols_array(r.try_into().unwrap()).transpose();
+            (yaw * r).transpose().to_cols_array()
+        })
+        .collect();
+    let mut yawed = batch.inputs.clone();
+    yawed.frames = Some(model::tensors::vec_tensor(turned, [1, 60, 9], &device));
+    let t = |i: &NetInputs| {
+        let t = model
+            .translations(i, batch.warped.clone(), &topo_t)
+            .unwrap();
+        model::tensors::read_points(t).unwrap().remove(0)
+    };
+    let (plain_t, yawed_t) = (t(&batch.inputs), t(&yawed));
+    let worst = plain_t
+        .iter()
+        .zip(&yawed_t)
+        .map(|(a, b)| (yaw * *a).distance(*b))
+        .fold(0.0, f32::max);
+    assert!(
+        worst < 1e-5 && plain_t.iter().any(|v| v.length() > 1e-4),
+        "{worst}"
+    );
+    // Each extra input left out (bit 0 contact, 1 template vertices, 2 vertex frames).
     let without = |leave_out: u8| {
         let mut i = batch.inputs.clone();
         if leave_out & 1 != 0 {
@@ -301,24 +342,32 @@ fn extended_network_takes_its_inputs_and_only_it() {
         if leave_out & 2 != 0 {
             i.rest = None;
         }
+        if leave_out & 4 != 0 {
+            i.frames = None;
+        }
         i
     };
-    let wants = ["body-contact features", "template vertices"];
+    let wants = [
+        "body-contact features",
+        "template vertices",
+        "vertex frames",
+    ];
     let plain = cfg
         .with_body_contact(false)
         .with_rest_input(false)
+        .with_vertex_frames(false)
         .init(&device)
         .unwrap();
-    assert!(!plain.body_contact && !plain.rest_input);
+    assert!(!plain.body_contact && !plain.rest_input && !plain.vertex_frames);
     for (bit, what) in wants.iter().enumerate() {
         let err = run(&model, &without(1 << bit)).unwrap_err().to_string();
         assert!(err.contains(&format!("needs {what}")), "{err}");
-        let err = run(&plain, &without(3 & !(1 << bit)))
+        let err = run(&plain, &without(7 & !(1 << bit)))
             .unwrap_err()
             .to_string();
         assert!(err.contains(&format!("takes no {what}")), "{err}");
     }
-    assert!(run(&plain, &without(3)).is_ok());
+    assert!(run(&plain, &without(7)).is_ok());
     // Through a checkpoint: the faces come back and a drape computes the same inputs.
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("c.garnet");
@@ -424,7 +473,7 @@ fn batch_refuses_mismatched_samples() {
     let device = Device::flex();
     let s = setup(Variant::Global, 60);
     let topo = GarmentTopology::from_mesh(&s.template).unwrap();
-    let spec = s.input_spec();
+    let spec = s.input_spec().unwrap();
     let mut bad = samples(&s, 2);
     bad[1].warped.pop();
     assert!(Batch::new(&bad, &topo, &spec, &device).is_err());
@@ -583,6 +632,64 @@ fn a_per_step_schedule_changes_the_rate_inside_each_epoch() {
 }
 
 #[test]
+fn a_compute_budget_ends_the_run_sets_its_rate_and_extends_on_resume() {
+    let device = Device::flex();
+    let dir = tempfile::tempdir().unwrap();
+    let s = setup(Variant::Naive, 60);
+    let data = samples(&s, 3);
+    let train = || {
+        data.chunks(1)
+            .map(|c| Ok::<_, String>(c.to_vec()))
+            .collect::<Vec<_>>()
+    };
+    let no_valid = None::<fn() -> Vec<_>>;
+    // 0.3 CPU seconds: a fraction of what 1000 epochs take, at least a step.
+    let budget = TimeBudget::new(0.005, 0.0, 1e-3, 1e-5).unwrap();
+    let mut trainer = Trainer::new(s.clone(), LossConfig::new(), 1e-3, &device).unwrap();
+    trainer.set_budget(Some(budget));
+    let reports = trainer
+        .fit(1000, |_, _| train(), no_valid, dir.path(), |_| {})
+        .unwrap();
+    let state = trainer.state().clone();
+    assert!(
+        trainer.budget_spent() && state.train_cpu_s >= 0.3,
+        "{state:?}"
+    );
+    assert!(
+        state.epoch < 1000 && state.epoch == reports.len(),
+        "{state:?}"
+    );
+    // The last step ran just under the budget's end: near the cosine's end rate.
+    assert!(state.lr < 1e-4, "{state:?}");
+    assert_eq!(reports.last().unwrap().train_cpu_s, state.train_cpu_s);
+    // Resumed with the same budget there is nothing left to do; with twice it goes on.
+    let (last, _, metrics) = Trainer::output_paths(dir.path());
+    let mut again = Trainer::resume(&last, None, &device).unwrap();
+    assert_eq!(again.state().budget, Some(budget));
+    let none = again
+        .fit(1000, |_, _| train(), no_valid, dir.path(), |_| {})
+        .unwrap();
+    assert!(none.is_empty());
+    again.set_budget(Some(TimeBudget::new(0.01, 0.0, 1e-3, 1e-5).unwrap()));
+    let more = again
+        .fit(1000, |_, _| train(), no_valid, dir.path(), |_| {})
+        .unwrap();
+    assert!(!more.is_empty() && again.state().train_cpu_s >= 0.6);
+    assert!(again.state().step > state.step);
+    let csv = std::fs::read_to_string(metrics).unwrap();
+    let cpu: f64 = csv
+        .lines()
+        .last()
+        .unwrap()
+        .rsplit(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((cpu - again.state().train_cpu_s).abs() < 0.06, "{cpu}");
+}
+
+#[test]
 fn trainer_writes_checkpoints_and_metrics_and_resumes() {
     let device = Device::flex();
     let dir = tempfile::tempdir().unwrap();
@@ -626,11 +733,10 @@ fn trainer_writes_checkpoints_and_metrics_and_resumes() {
     assert_eq!(reports[0].lr, 1e-3);
     assert!((reports[1].lr - schedule.lr(1)).abs() < 1e-15);
     assert!(reports.iter().all(|r| r.grad_norm > 0.0));
-    assert!(text
-        .lines()
-        .nth(1)
-        .unwrap()
-        .ends_with(&format!(",{}", reports[0].grad_norm)));
+    assert!(text.lines().nth(1).unwrap().ends_with(&format!(
+        ",{},{:.1}",
+        reports[0].grad_norm, reports[0].train_cpu_s
+    )));
 
     // The resumed run keeps the clipping and the schedule (a new plan of the same rates
     // and end keeps the old start).
@@ -954,7 +1060,13 @@ fn an_epoch_stopped_inside_resumes_where_it_stopped() {
     );
     let state = load_checkpoint(&last).unwrap().state;
     assert_eq!((state.step, &state.partial), (8, &None));
-    assert_eq!(state, load_checkpoint(&whole_last).unwrap().state);
+    // The same state, but for the CPU time each run took.
+    let whole = load_checkpoint(&whole_last).unwrap().state;
+    let untimed = |s: TrainState| TrainState {
+        train_cpu_s: 0.0,
+        ..s
+    };
+    assert_eq!(untimed(state), untimed(whole));
     // Adam's moments too: one more epoch from each gives the same network.
     for path in [&last, &whole_last] {
         let mut t = Trainer::resume(path, None, &device).unwrap();
