@@ -6,7 +6,7 @@ use std::sync::Arc;
 use burn::prelude::*;
 use glam::Vec3;
 
-use crate::contact::{contact_features, CONTACT_WIDTH};
+use crate::contact::{contact_features, surface_contact_features, CONTACT_WIDTH};
 use crate::error::{check_count, check_finite, ModelError, Result};
 use crate::frame::CanonicalFrame;
 use crate::local::{BodySampling, LocalIndices};
@@ -113,6 +113,9 @@ pub struct InputSpec {
     /// The body faces `[F]` when the network takes body-contact features (see
     /// [`crate::contact`]; the faces give the body normals).
     pub contact_faces: Option<Vec<[u32; 3]>>,
+    /// Whether the contact features are measured to the closest surface point (see
+    /// [`crate::GarNetConfig::contact_surface`]) rather than the nearest body vertex.
+    pub contact_surface: bool,
     /// The template's vertices `[N]` (metres) when the network takes them as an input (see
     /// [`crate::GarNetConfig::rest_input`]).
     pub rest_input: Option<Vec<Vec3>>,
@@ -165,13 +168,19 @@ impl InputSpec {
         };
         let mut flat = Vec::new();
         for (b, (body, m)) in bodies.iter().zip(warped).enumerate() {
-            let features = match &known {
-                Some(k) => contact_features(&k.index[b], body, k.normals[b], m)?,
+            let computed;
+            let normals = match &known {
+                Some(k) => k.normals[b],
                 None => {
                     geom::adjacency::check_indices(body.len(), faces)?;
-                    let normals = geom::normals::vertex_normals(body, faces);
-                    contact_features(&geom::KnnIndex::new(body)?, body, &normals, m)?
+                    computed = geom::normals::vertex_normals(body, faces);
+                    &computed
                 }
+            };
+            let features = match (self.contact_surface, &known) {
+                (true, _) => surface_contact_features(&geom::Bvh::new(body, faces)?, normals, m)?,
+                (false, Some(k)) => contact_features(&k.index[b], body, normals, m)?,
+                (false, None) => contact_features(&geom::KnnIndex::new(body)?, body, normals, m)?,
             };
             flat.extend(features);
         }

@@ -155,6 +155,7 @@ impl ModelSetup {
                 .body_contact
                 .then(|| self.body_faces.clone())
                 .flatten(),
+            contact_surface: self.config.contact_surface,
             rest_input: self
                 .config
                 .rest_input

@@ -458,6 +458,7 @@ mod tests {
             local: None,
             canonical_rest: None,
             contact_faces: None,
+            contact_surface: false,
             rest_input: None,
             vertex_frames: None,
         };
@@ -659,6 +660,7 @@ mod tests {
             local: None,
             canonical_rest: None,
             contact_faces: None,
+            contact_surface: false,
             rest_input: None,
             vertex_frames: None,
         };

@@ -110,6 +110,9 @@ pub struct NetworkRecipe {
     /// [`GarNetConfig::vertex_frames`] (default false: the paper's world-frame output).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub vertex_frames: bool,
+    /// [`GarNetConfig::contact_surface`] (default false: the nearest body vertex).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub contact_surface: bool,
     /// [`GarNetConfig::seed`]: the initial parameters' seed.
     #[serde(default)]
     pub seed: u64,
@@ -345,6 +348,7 @@ impl Recipe {
             .with_body_contact(n.body_contact)
             .with_rest_input(n.rest_input)
             .with_vertex_frames(n.vertex_frames)
+            .with_contact_surface(n.contact_surface)
             .with_seed(n.seed);
         if let Some(v) = n.body_subsample {
             c.body_subsample = v;

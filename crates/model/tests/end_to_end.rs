@@ -353,6 +353,7 @@ fn extended_network_takes_its_inputs_and_only_it() {
         "vertex frames",
     ];
     let plain = cfg
+        .clone()
         .with_body_contact(false)
         .with_rest_input(false)
         .with_vertex_frames(false)
@@ -368,6 +369,35 @@ fn extended_network_takes_its_inputs_and_only_it() {
         assert!(err.contains(&format!("takes no {what}")), "{err}");
     }
     assert!(run(&plain, &without(7)).is_ok());
+    // Measured to the closest surface point instead: the batch has those features.
+    let surface_cfg = cfg.clone().with_contact_surface(true);
+    assert!(cfg
+        .clone()
+        .with_body_contact(false)
+        .with_contact_surface(true)
+        .validate()
+        .is_err());
+    let surface_setup = ModelSetup::new(surface_cfg, template.clone(), &body)
+        .unwrap()
+        .with_body_faces(body_topo.faces.clone())
+        .unwrap();
+    let spec = surface_setup.input_spec().unwrap();
+    let again = Sample::new(body.clone(), &body_topo, template.vertices.clone(), None).unwrap();
+    let got = Batch::new(&[again], &topo, &spec, &device)
+        .unwrap()
+        .inputs
+        .contact
+        .unwrap();
+    let bvh = geom::Bvh::new(&body, &body_topo.faces).unwrap();
+    let want =
+        model::contact::surface_contact_features(&bvh, &normals, &template.vertices).unwrap();
+    let got = model::tensors::read_f32(got).unwrap();
+    let worst = got
+        .iter()
+        .zip(&want)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f32::max);
+    assert!(worst < 1e-3, "{worst}");
     // Through a checkpoint: the faces come back and a drape computes the same inputs.
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("c.garnet");
