@@ -233,6 +233,31 @@ pub struct TrainState {
     pub partial: Option<EpochProgress>,
 }
 
+/// `stored`, a JSON object of `T`'s fields, read with every field it leaves out taken from
+/// `defaults`: an option added to a config after a file was written reads as its default.
+fn with_defaults<T>(stored: &str, defaults: T) -> serde_json::Result<T>
+where
+    T: Serialize + serde::de::DeserializeOwned,
+{
+    let mut merged = serde_json::to_value(defaults)?;
+    let stored: serde_json::Value = serde_json::from_str(stored)?;
+    match (merged.as_object_mut(), stored) {
+        (Some(all), serde_json::Value::Object(given)) => all.extend(given),
+        (_, other) => merged = other,
+    }
+    serde_json::from_value(merged)
+}
+
+/// A stored [`GarNetConfig`] (see [`with_defaults`]; the defaults of its variant).
+fn stored_config(stored: &str) -> serde_json::Result<GarNetConfig> {
+    #[derive(Deserialize)]
+    struct Named {
+        variant: crate::config::Variant,
+    }
+    let named: Named = serde_json::from_str(stored)?;
+    with_defaults(stored, GarNetConfig::new(named.variant))
+}
+
 /// A checkpoint read from disk; [`Checkpoint::model`] and [`Checkpoint::optimizer`] rebuild
 /// the network and the optimiser.
 pub struct Checkpoint {
@@ -398,10 +423,10 @@ pub fn load_checkpoint(path: &Path) -> Result<Checkpoint> {
         meta.get(key)
             .ok_or_else(|| bad(format!("missing metadata {key}")))
     };
-    let config: GarNetConfig =
-        serde_json::from_str(field("config")?).map_err(|e| bad(format!("metadata config: {e}")))?;
-    let loss: LossConfig =
-        serde_json::from_str(field("loss")?).map_err(|e| bad(format!("metadata loss: {e}")))?;
+    let config =
+        stored_config(field("config")?).map_err(|e| bad(format!("metadata config: {e}")))?;
+    let loss = with_defaults(field("loss")?, LossConfig::new())
+        .map_err(|e| bad(format!("metadata loss: {e}")))?;
     let state: TrainState =
         serde_json::from_str(field("state")?).map_err(|e| bad(format!("metadata state: {e}")))?;
     let recipe = match meta.get("recipe") {
@@ -529,5 +554,34 @@ impl Checkpoint {
     /// Whether the checkpoint holds an optimiser state.
     pub fn has_optimizer(&self) -> bool {
         self.optimizer_bytes.is_some()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::Variant;
+    use crate::loss::NormalLoss;
+
+    /// A config or loss written before an option existed reads with the option's default;
+    /// what the file sets is kept, and text that is not a config is refused.
+    #[test]
+    fn options_a_stored_config_leaves_out_take_their_defaults() {
+        let cfg = GarNetConfig::new(Variant::Global)
+            .with_conv_width(48)
+            .with_body_contact(true);
+        let mut json: serde_json::Value = serde_json::to_value(&cfg).unwrap();
+        let object = json.as_object_mut().unwrap();
+        object.remove("vertex_frames");
+        object.remove("contact_surface");
+        let read = stored_config(&json.to_string()).unwrap();
+        assert_eq!(read, cfg);
+        let loss = LossConfig::new().with_norm(0.7);
+        let mut json: serde_json::Value = serde_json::to_value(&loss).unwrap();
+        json.as_object_mut().unwrap().remove("normal_loss");
+        let read: LossConfig = with_defaults(&json.to_string(), LossConfig::new()).unwrap();
+        assert_eq!((read.norm, read.normal_loss), (0.7, NormalLoss::Paper));
+        assert!(stored_config("{\"conv_width\": 48}").is_err());
+        assert!(with_defaults("[1, 2]", LossConfig::new()).is_err());
     }
 }
