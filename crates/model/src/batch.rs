@@ -6,13 +6,12 @@ use std::sync::Arc;
 use burn::prelude::*;
 use glam::Vec3;
 
-use crate::contact::{contact_features, surface_contact_features, CONTACT_WIDTH};
+use crate::contact::{contact_features, CONTACT_WIDTH};
 use crate::error::{check_count, check_finite, ModelError, Result};
 use crate::frame::CanonicalFrame;
 use crate::local::{BodySampling, LocalIndices};
 use crate::tensors::{points_tensor, vec_tensor};
 use crate::topology::GarmentTopology;
-use crate::vertex_frame::VertexFrames;
 
 /// The body mesh connectivity shared by the samples of a dataset (all bodies have one
 /// topology): faces and unique edges, for the body normals and mean edge length that the
@@ -113,15 +112,9 @@ pub struct InputSpec {
     /// The body faces `[F]` when the network takes body-contact features (see
     /// [`crate::contact`]; the faces give the body normals).
     pub contact_faces: Option<Vec<[u32; 3]>>,
-    /// Whether the contact features are measured to the closest surface point (see
-    /// [`crate::GarNetConfig::contact_surface`]) rather than the nearest body vertex.
-    pub contact_surface: bool,
     /// The template's vertices `[N]` (metres) when the network takes them as an input (see
     /// [`crate::GarNetConfig::rest_input`]).
     pub rest_input: Option<Vec<Vec3>>,
-    /// The template's neighbourhoods when the network works in each vertex's frame (see
-    /// [`crate::GarNetConfig::vertex_frames`]).
-    pub vertex_frames: Option<Arc<VertexFrames>>,
 }
 
 impl InputSpec {
@@ -168,19 +161,13 @@ impl InputSpec {
         };
         let mut flat = Vec::new();
         for (b, (body, m)) in bodies.iter().zip(warped).enumerate() {
-            let computed;
-            let normals = match &known {
-                Some(k) => k.normals[b],
+            let features = match &known {
+                Some(k) => contact_features(&k.index[b], body, k.normals[b], m)?,
                 None => {
                     geom::adjacency::check_indices(body.len(), faces)?;
-                    computed = geom::normals::vertex_normals(body, faces);
-                    &computed
+                    let normals = geom::normals::vertex_normals(body, faces);
+                    contact_features(&geom::KnnIndex::new(body)?, body, &normals, m)?
                 }
-            };
-            let features = match (self.contact_surface, &known) {
-                (true, _) => surface_contact_features(&geom::Bvh::new(body, faces)?, normals, m)?,
-                (false, Some(k)) => contact_features(&k.index[b], body, normals, m)?,
-                (false, None) => contact_features(&geom::KnnIndex::new(body)?, body, normals, m)?,
             };
             flat.extend(features);
         }
@@ -226,26 +213,11 @@ impl InputSpec {
             let copies: Vec<&[Vec3]> = warped.iter().map(|_| r.as_slice()).collect();
             points_tensor(&copies, device)
         });
-        let frames = match &self.vertex_frames {
-            Some(f) => {
-                let mut flat = Vec::new();
-                for m in warped {
-                    for r in f.rotations(m)? {
-                        // The transpose's columns are r's rows: r row-major.
-                        flat.extend(r.transpose().to_cols_array());
-                    }
-                }
-                let n = warped.first().map_or(0, |m| m.len());
-                Some(vec_tensor(flat, [warped.len(), n, 9], device))
-            }
-            None => None,
-        };
         Ok(NetInputs {
             body_stream: points_tensor(&refs, device),
             local,
             contact,
             rest,
-            frames,
         })
     }
 }
@@ -271,9 +243,6 @@ pub struct NetInputs {
     pub contact: Option<Tensor<3>>,
     /// The template's vertices `[B,N,3]`, metres (see [`crate::GarNetConfig::rest_input`]).
     pub rest: Option<Tensor<3>>,
-    /// Each vertex's frame `[B,N,9]`: the rotation from the template to M (see
-    /// [`crate::vertex_frame`]), row-major (`[3r + c]` is row r, column c).
-    pub frames: Option<Tensor<3>>,
 }
 
 /// A batch of B samples as tensors on one device, sharing one garment topology.

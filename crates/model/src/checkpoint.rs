@@ -24,7 +24,6 @@
 
 use std::collections::HashMap;
 use std::path::Path;
-use std::sync::Arc;
 
 use burn::optim::ModuleOptimizer;
 use burn::prelude::*;
@@ -45,7 +44,6 @@ use crate::local::BodySampling;
 use crate::loss::LossConfig;
 use crate::recipe::{Recipe, RecipeRecord};
 use crate::schedule::{CosineSchedule, TimeBudget};
-use crate::vertex_frame::VertexFrames;
 
 /// The format name in a checkpoint's metadata.
 pub const FORMAT: &str = "garnet-model-2";
@@ -139,10 +137,9 @@ impl ModelSetup {
         self
     }
 
-    /// How samples become this network's inputs. Fails on a template with a face index out
-    /// of range (which [`ModelSetup::validate`] refuses).
-    pub fn input_spec(&self) -> Result<InputSpec> {
-        Ok(InputSpec {
+    /// How samples become this network's inputs.
+    pub fn input_spec(&self) -> InputSpec {
+        InputSpec {
             sampling: self.body_sampling.clone(),
             local: self
                 .config
@@ -155,17 +152,11 @@ impl ModelSetup {
                 .body_contact
                 .then(|| self.body_faces.clone())
                 .flatten(),
-            contact_surface: self.config.contact_surface,
             rest_input: self
                 .config
                 .rest_input
                 .then(|| self.template.vertices.clone()),
-            vertex_frames: self
-                .config
-                .vertex_frames
-                .then(|| VertexFrames::new(&self.template).map(Arc::new))
-                .transpose()?,
-        })
+        }
     }
 
     /// Fails when the body skinning is not one of [`BODY_SKINNINGS`], the template or the
@@ -572,8 +563,7 @@ mod tests {
             .with_body_contact(true);
         let mut json: serde_json::Value = serde_json::to_value(&cfg).unwrap();
         let object = json.as_object_mut().unwrap();
-        object.remove("vertex_frames");
-        object.remove("contact_surface");
+        object.remove("rest_input");
         let read = stored_config(&json.to_string()).unwrap();
         assert_eq!(read, cfg);
         let loss = LossConfig::new().with_norm(0.7);

@@ -133,17 +133,6 @@ pub struct GarNetConfig {
     /// which vertex it is looking at whatever the pose. Off in the paper's networks.
     #[config(default = false)]
     pub rest_input: bool,
-    /// Our extension (not in the paper): the network predicts each vertex's translation in
-    /// the vertex's own frame (the rotation carrying the template's neighbourhood of the
-    /// vertex onto M's, see [`crate::vertex_frame`]), and the garment stream also takes the
-    /// direction of gravity in that frame. Off in the paper's networks.
-    #[config(default = false)]
-    pub vertex_frames: bool,
-    /// Our extension: with [`GarNetConfig::body_contact`], the contact features are measured
-    /// to the closest point of the body's surface (vertex normals interpolated there) rather
-    /// than to the nearest body vertex (see [`crate::contact`]).
-    #[config(default = false)]
-    pub contact_surface: bool,
     /// Width of the global garment feature (a shared layer then max pooling over vertices).
     #[config(default = 256)]
     pub garment_global: usize,
@@ -233,11 +222,6 @@ impl GarNetConfig {
                 self.input_scale, self.input_centre
             )));
         }
-        if self.contact_surface && !self.body_contact {
-            return Err(ModelError::InvalidInput(
-                "contact_surface measures the body-contact features: it needs body_contact".into(),
-            ));
-        }
         if self.variant.has_mesh_conv() && (self.conv_blocks == 0 || self.convs_per_block == 0) {
             return Err(ModelError::InvalidInput(
                 "GarNet-Global and -Local need at least one mesh-convolution block".into(),
@@ -255,12 +239,6 @@ impl GarNetConfig {
         }
         if self.rest_input {
             name.push_str(" +rest");
-        }
-        if self.vertex_frames {
-            name.push_str(" +frames");
-        }
-        if self.contact_surface {
-            name.push_str(" +surface");
         }
         name
     }

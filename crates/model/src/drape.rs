@@ -49,7 +49,7 @@ impl Draper {
         setup.validate()?;
         let topology = GarmentTopology::from_mesh(&setup.template)?;
         let topo = topology.to_device(&device);
-        let spec = setup.input_spec()?;
+        let spec = setup.input_spec();
         let model = model.valid().to_device(&device);
         Ok(Draper {
             model,

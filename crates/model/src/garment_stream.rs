@@ -161,9 +161,6 @@ impl GarmentStream {
         if cfg.body_contact {
             d += CONTACT_WIDTH;
         }
-        if cfg.vertex_frames {
-            d += 3;
-        }
         for &w in &cfg.garment_mlp {
             mlp.push(CondLinear::new(d, cb, w, init, device));
             d = w;
@@ -192,8 +189,7 @@ impl GarmentStream {
     /// `warped` M `[B,N,3]` (network unit), `body_global` `[B,Cb]`, and the extra per-vertex
     /// inputs of the first layer (with [`GarNetConfig::rest_input`] the template's vertices
     /// `[B,N,3]` in the network unit, with [`GarNetConfig::body_contact`] the contact features
-    /// `[B,N,CONTACT_WIDTH]`, with [`GarNetConfig::vertex_frames`] gravity in each vertex's
-    /// frame `[B,N,3]`, in that order) -> point-wise, patch-wise and global garment
+    /// `[B,N,CONTACT_WIDTH]`, in that order) -> point-wise, patch-wise and global garment
     /// features.
     pub fn forward(
         &self,

@@ -32,9 +32,6 @@ pub struct GarNet {
     pub body_contact: bool,
     /// Whether the garment stream takes the template's vertices ([`GarNetConfig::rest_input`]).
     pub rest_input: bool,
-    /// Whether translations are predicted in each vertex's frame
-    /// ([`GarNetConfig::vertex_frames`]).
-    pub vertex_frames: bool,
 }
 
 impl GarNetConfig {
@@ -67,7 +64,6 @@ impl GarNetConfig {
             input_centre: self.input_centre.clone(),
             body_contact: self.body_contact,
             rest_input: self.rest_input,
-            vertex_frames: self.vertex_frames,
         })
     }
 }
@@ -93,8 +89,7 @@ impl GarNet {
     ///   required by GarNet-Local; the body-contact features of M `[B,N,CONTACT_WIDTH]` (see
     ///   [`crate::contact`]), required by a network with [`GarNet::body_contact`] and refused
     ///   by the others; the template's vertices `[B,N,3]` (metres), likewise with
-    ///   [`GarNet::rest_input`]; each vertex's frame `[B,N,9]` (see [`NetInputs::frames`]),
-    ///   likewise with [`GarNet::vertex_frames`]: the translations are then predicted in it.
+    ///   [`GarNet::rest_input`].
     /// - `warped`: the DQS-warped garment M `[B,N,3]`, metres.
     /// - `topo`: the garment template's connectivity (N vertices).
     pub fn translations(
@@ -128,7 +123,6 @@ impl GarNet {
                 "body-contact features",
             ),
             (&inputs.rest, self.rest_input, 3, "template vertices"),
-            (&inputs.frames, self.vertex_frames, 9, "vertex frames"),
         ];
         for (given, wanted, width, what) in extras {
             if given.as_ref().map(|t| t.dims()) != wanted.then_some([b, n, width]) {
@@ -149,12 +143,6 @@ impl GarNet {
             extra.push((r.clone() - centre) / unit);
         }
         extra.extend(inputs.contact.clone());
-        // Gravity (-Y) in each vertex's frame: R^T (0, -1, 0), minus R's second column.
-        let frames = inputs.frames.clone();
-        if let Some(r) = &frames {
-            let column = Tensor::<1, Int>::from_ints([1, 4, 7], &r.device());
-            extra.push(r.clone().select(2, column).neg());
-        }
         let body_features = self.body.forward(body);
         let garment = self
             .garment
@@ -181,14 +169,7 @@ impl GarNet {
             per_vertex.push(pool.forward(body_features.points, idx));
         }
         let global = Tensor::cat(vec![garment.global, body_features.global], 1);
-        let t = self.fusion.forward(per_vertex, global) * unit;
-        Ok(match frames {
-            // T = R t: the prediction is in each vertex's frame.
-            Some(r) => (r.reshape([b, n, 3, 3]) * t.reshape([b, n, 1, 3]))
-                .sum_dim(3)
-                .reshape([b, n, 3]),
-            None => t,
-        })
+        Ok(self.fusion.forward(per_vertex, global) * unit)
     }
 
     /// The predicted draped garment `G = M + T` `[B,N,3]` (metres); arguments as

@@ -64,7 +64,6 @@ pub mod tensors;
 pub mod topology;
 pub mod train;
 pub mod trainer;
-pub mod vertex_frame;
 
 pub use alloc::tune_allocator;
 pub use batch::{Batch, BodyTopology, InputSpec, KnownBodies, NetInputs, Sample};
@@ -82,7 +81,6 @@ pub use schedule::{CosineSchedule, TimeBudget};
 pub use topology::{GarmentTopology, TopologyTensors};
 pub use train::{adam, evaluate_batch, train_step, Evaluation, StepReport, PAPER_LEARNING_RATE};
 pub use trainer::{EpochReport, Trainer, Validation};
-pub use vertex_frame::VertexFrames;
 
 /// burn's optimiser type used for GarNet (Adam).
 pub use burn::optim::ModuleOptimizer as Optimizer;

@@ -458,9 +458,7 @@ mod tests {
             local: None,
             canonical_rest: None,
             contact_faces: None,
-            contact_surface: false,
             rest_input: None,
-            vertex_frames: None,
         };
         let b = Batch::new(&[sample], &topo, &spec, device).unwrap();
         (b, topo.to_device(device))
@@ -660,9 +658,7 @@ mod tests {
             local: None,
             canonical_rest: None,
             contact_faces: None,
-            contact_surface: false,
             rest_input: None,
-            vertex_frames: None,
         };
         let cfg = LossConfig::new().with_vertex_loss(vertex_loss);
         let loss_at = |p: &[Vec3]| -> f64 {

@@ -107,12 +107,6 @@ pub struct NetworkRecipe {
     /// [`GarNetConfig::rest_input`] (default false: the paper's inputs).
     #[serde(default)]
     pub rest_input: bool,
-    /// [`GarNetConfig::vertex_frames`] (default false: the paper's world-frame output).
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub vertex_frames: bool,
-    /// [`GarNetConfig::contact_surface`] (default false: the nearest body vertex).
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub contact_surface: bool,
     /// [`GarNetConfig::seed`]: the initial parameters' seed.
     #[serde(default)]
     pub seed: u64,
@@ -347,8 +341,6 @@ impl Recipe {
         let mut c = GarNetConfig::new(self.variant()?)
             .with_body_contact(n.body_contact)
             .with_rest_input(n.rest_input)
-            .with_vertex_frames(n.vertex_frames)
-            .with_contact_surface(n.contact_surface)
             .with_seed(n.seed);
         if let Some(v) = n.body_subsample {
             c.body_subsample = v;

@@ -171,7 +171,7 @@ impl Trainer {
         let topo = topology.to_device(&device);
         let topo_valid = topology.to_device(&device.clone().inner());
         setup.validate()?;
-        let spec = setup.input_spec()?;
+        let spec = setup.input_spec();
         Ok(Trainer {
             model,
             optim,

@@ -48,7 +48,7 @@ fn every_variant_outputs_b_n_3() {
         let n = s.template.num_vertices();
         let model = s.config.init(&device).unwrap();
         let topo = GarmentTopology::from_mesh(&s.template).unwrap();
-        let batch = Batch::new(&samples(&s, 2), &topo, &s.input_spec().unwrap(), &device).unwrap();
+        let batch = Batch::new(&samples(&s, 2), &topo, &s.input_spec(), &device).unwrap();
         assert_eq!(batch.inputs.local.is_some(), variant == Variant::Local);
         let out = model
             .forward(
@@ -85,7 +85,7 @@ fn local_variant_needs_its_tables() {
     let s = setup(Variant::Local, 60);
     let model = s.config.init(&device).unwrap();
     let topo = GarmentTopology::from_mesh(&s.template).unwrap();
-    let batch = Batch::new(&samples(&s, 1), &topo, &s.input_spec().unwrap(), &device).unwrap();
+    let batch = Batch::new(&samples(&s, 1), &topo, &s.input_spec(), &device).unwrap();
     let mut inputs = batch.inputs.clone();
     inputs.local = None;
     let err = model
@@ -232,7 +232,7 @@ fn drapes_on_the_host_match_the_tensor_ops() {
             .collect();
         let run = |device: &Device| {
             let model = setup.config.init(device).unwrap();
-            let batch = Batch::new(&samples, &topo, &setup.input_spec().unwrap(), device).unwrap();
+            let batch = Batch::new(&samples, &topo, &setup.input_spec(), device).unwrap();
             let pred = model.forward(&batch.inputs, batch.warped.clone(), &topo.to_device(device));
             model::tensors::read_points(pred.unwrap()).unwrap()
         };
@@ -253,14 +253,13 @@ fn extended_network_takes_its_inputs_and_only_it() {
     let (body, body_topo) = meshed_body();
     let cfg = GarNetConfig::tiny(Variant::Local)
         .with_body_contact(true)
-        .with_rest_input(true)
-        .with_vertex_frames(true);
+        .with_rest_input(true);
     let template = tube_garment(60);
     let setup = ModelSetup::new(cfg.clone(), template.clone(), &body).unwrap();
     assert!(setup.validate().is_err(), "no body faces");
     let setup = setup.with_body_faces(body_topo.faces.clone()).unwrap();
     let model = setup.config.init(&device).unwrap();
-    assert!(model.body_contact && model.rest_input && model.vertex_frames);
+    assert!(model.body_contact && model.rest_input);
     let sample = Sample::new(
         body.clone(),
         &body_topo,
@@ -273,7 +272,7 @@ fn extended_network_takes_its_inputs_and_only_it() {
     .unwrap();
     let topo = GarmentTopology::from_mesh(&template).unwrap();
     let topo_t = topo.to_device(&device);
-    let batch = Batch::new(&[sample], &topo, &setup.input_spec().unwrap(), &device).unwrap();
+    let batch = Batch::new(&[sample], &topo, &setup.input_spec(), &device).unwrap();
     let contact = batch.inputs.contact.clone().expect("contact features");
     // M is the template, so the canonical frame is the identity.
     let normals = geom::normals::vertex_normals(&body, &body_topo.faces);
@@ -290,50 +289,10 @@ fn extended_network_takes_its_inputs_and_only_it() {
     assert!(worst < 1e-3, "{worst}");
     let rest = model::tensors::read_points(batch.inputs.rest.clone().unwrap()).unwrap();
     assert_eq!(rest[0], template.vertices);
-    // M is the template: every vertex frame is the identity.
-    let frames = batch.inputs.frames.clone().expect("vertex frames");
-    assert_eq!(frames.dims(), [1, 60, 9]);
-    let identity = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
-    for (k, v) in model::tensors::read_f32(frames.clone())
-        .unwrap()
-        .iter()
-        .enumerate()
-    {
-        assert!((v - identity[k % 9]).abs() < 1e-4, "entry {k}: {v}");
-    }
     let run =
         |m: &model::GarNet, inputs: &NetInputs| m.forward(inputs, batch.warped.clone(), &topo_t);
     let pred = model::tensors::read_points(run(&model, &batch.inputs).unwrap()).unwrap();
-    // Frames turned about gravity leave the gravity input as it was, so the translations
-    // (in each vertex's frame) turn with them.
-    let yaw = glam::Mat3::from_rotation_y(0.8);
-    let turned: Vec<f32> = model::tensors::read_f32(frames)
-        .unwrap()
-        .chunks(9)
-        .flat_map(|r| {
-            let r = glam::Mat3::from_cols_array(r.try_into().unwrap()).transpose();
-            (yaw * r).transpose().to_cols_array()
-        })
-        .collect();
-    let mut yawed = batch.inputs.clone();
-    yawed.frames = Some(model::tensors::vec_tensor(turned, [1, 60, 9], &device));
-    let t = |i: &NetInputs| {
-        let t = model
-            .translations(i, batch.warped.clone(), &topo_t)
-            .unwrap();
-        model::tensors::read_points(t).unwrap().remove(0)
-    };
-    let (plain_t, yawed_t) = (t(&batch.inputs), t(&yawed));
-    let worst = plain_t
-        .iter()
-        .zip(&yawed_t)
-        .map(|(a, b)| (yaw * *a).distance(*b))
-        .fold(0.0, f32::max);
-    assert!(
-        worst < 1e-5 && plain_t.iter().any(|v| v.length() > 1e-4),
-        "{worst}"
-    );
-    // Each extra input left out (bit 0 contact, 1 template vertices, 2 vertex frames).
+    // Each extra input left out (bit 0 contact, 1 template vertices).
     let without = |leave_out: u8| {
         let mut i = batch.inputs.clone();
         if leave_out & 1 != 0 {
@@ -342,62 +301,24 @@ fn extended_network_takes_its_inputs_and_only_it() {
         if leave_out & 2 != 0 {
             i.rest = None;
         }
-        if leave_out & 4 != 0 {
-            i.frames = None;
-        }
         i
     };
-    let wants = [
-        "body-contact features",
-        "template vertices",
-        "vertex frames",
-    ];
+    let wants = ["body-contact features", "template vertices"];
     let plain = cfg
-        .clone()
         .with_body_contact(false)
         .with_rest_input(false)
-        .with_vertex_frames(false)
         .init(&device)
         .unwrap();
-    assert!(!plain.body_contact && !plain.rest_input && !plain.vertex_frames);
+    assert!(!plain.body_contact && !plain.rest_input);
     for (bit, what) in wants.iter().enumerate() {
         let err = run(&model, &without(1 << bit)).unwrap_err().to_string();
         assert!(err.contains(&format!("needs {what}")), "{err}");
-        let err = run(&plain, &without(7 & !(1 << bit)))
+        let err = run(&plain, &without(3 & !(1 << bit)))
             .unwrap_err()
             .to_string();
         assert!(err.contains(&format!("takes no {what}")), "{err}");
     }
-    assert!(run(&plain, &without(7)).is_ok());
-    // Measured to the closest surface point instead: the batch has those features.
-    let surface_cfg = cfg.clone().with_contact_surface(true);
-    assert!(cfg
-        .clone()
-        .with_body_contact(false)
-        .with_contact_surface(true)
-        .validate()
-        .is_err());
-    let surface_setup = ModelSetup::new(surface_cfg, template.clone(), &body)
-        .unwrap()
-        .with_body_faces(body_topo.faces.clone())
-        .unwrap();
-    let spec = surface_setup.input_spec().unwrap();
-    let again = Sample::new(body.clone(), &body_topo, template.vertices.clone(), None).unwrap();
-    let got = Batch::new(&[again], &topo, &spec, &device)
-        .unwrap()
-        .inputs
-        .contact
-        .unwrap();
-    let bvh = geom::Bvh::new(&body, &body_topo.faces).unwrap();
-    let want =
-        model::contact::surface_contact_features(&bvh, &normals, &template.vertices).unwrap();
-    let got = model::tensors::read_f32(got).unwrap();
-    let worst = got
-        .iter()
-        .zip(&want)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f32::max);
-    assert!(worst < 1e-3, "{worst}");
+    assert!(run(&plain, &without(3)).is_ok());
     // Through a checkpoint: the faces come back and a drape computes the same inputs.
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("c.garnet");
@@ -503,7 +424,7 @@ fn batch_refuses_mismatched_samples() {
     let device = Device::flex();
     let s = setup(Variant::Global, 60);
     let topo = GarmentTopology::from_mesh(&s.template).unwrap();
-    let spec = s.input_spec().unwrap();
+    let spec = s.input_spec();
     let mut bad = samples(&s, 2);
     bad[1].warped.pop();
     assert!(Batch::new(&bad, &topo, &spec, &device).is_err());
