@@ -28,12 +28,7 @@ pub struct CosineSchedule {
 impl CosineSchedule {
     /// A schedule; fails when a rate is not a positive number or the epochs do not increase.
     pub fn new(start_lr: f64, end_lr: f64, from_epoch: usize, to_epoch: usize) -> Result<Self> {
-        let rate_ok = |r: f64| r.is_finite() && r > 0.0;
-        if !rate_ok(start_lr) || !rate_ok(end_lr) {
-            return Err(ModelError::InvalidInput(format!(
-                "learning rates must be > 0, got {start_lr} and {end_lr}"
-            )));
-        }
+        check_rates(start_lr, end_lr)?;
         if to_epoch <= from_epoch {
             return Err(ModelError::InvalidInput(format!(
                 "the schedule must end after it starts (epochs {from_epoch} to {to_epoch})"
@@ -108,12 +103,7 @@ pub struct TimeBudget {
 impl TimeBudget {
     /// A budget; fails when a rate is not a positive number or the minutes are out of range.
     pub fn new(minutes: f64, warmup_minutes: f64, start_lr: f64, end_lr: f64) -> Result<Self> {
-        let rate_ok = |r: f64| r.is_finite() && r > 0.0;
-        if !rate_ok(start_lr) || !rate_ok(end_lr) {
-            return Err(ModelError::InvalidInput(format!(
-                "learning rates must be > 0, got {start_lr} and {end_lr}"
-            )));
-        }
+        check_rates(start_lr, end_lr)?;
         if !(minutes.is_finite() && minutes > 0.0) {
             return Err(ModelError::InvalidInput(format!(
                 "the budget must be > 0 minutes, got {minutes}"
@@ -144,6 +134,17 @@ impl TimeBudget {
     pub fn spent(&self, cpu_s: f64) -> bool {
         cpu_s >= self.minutes * 60.0
     }
+}
+
+/// Fails unless both learning rates are positive numbers.
+fn check_rates(start_lr: f64, end_lr: f64) -> Result<()> {
+    let rate_ok = |r: f64| r.is_finite() && r > 0.0;
+    if !rate_ok(start_lr) || !rate_ok(end_lr) {
+        return Err(ModelError::InvalidInput(format!(
+            "learning rates must be > 0, got {start_lr} and {end_lr}"
+        )));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

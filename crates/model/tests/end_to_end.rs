@@ -546,18 +546,27 @@ fn corrupt_or_foreign_checkpoints_are_clear_errors() {
     .is_err());
 }
 
+/// A tiny Naive network's trainer and three samples to train it on.
+fn naive_trainer_on_three(device: &Device) -> (Trainer, Vec<Sample>) {
+    let s = setup(Variant::Naive, 60);
+    let data = samples(&s, 3);
+    (
+        Trainer::new(s, LossConfig::new(), 1e-3, device).unwrap(),
+        data,
+    )
+}
+
+/// `data` as batches of one sample.
+fn batches_of_one(data: &[Sample]) -> Vec<Result<Vec<Sample>, String>> {
+    data.chunks(1).map(|c| Ok(c.to_vec())).collect()
+}
+
 #[test]
 fn a_per_step_schedule_changes_the_rate_inside_each_epoch() {
     let device = Device::flex();
     let dir = tempfile::tempdir().unwrap();
-    let s = setup(Variant::Naive, 60);
-    let data = samples(&s, 3);
-    let train = || {
-        data.chunks(1)
-            .map(|c| Ok::<_, String>(c.to_vec()))
-            .collect::<Vec<_>>()
-    };
-    let mut trainer = Trainer::new(s.clone(), LossConfig::new(), 1e-3, &device).unwrap();
+    let (mut trainer, data) = naive_trainer_on_three(&device);
+    let train = || batches_of_one(&data);
     let schedule = CosineSchedule::new(1e-3, 1e-5, 0, 2).unwrap().per_step(3);
     trainer.set_schedule(Some(schedule));
     let reports = trainer
@@ -586,17 +595,11 @@ fn a_per_step_schedule_changes_the_rate_inside_each_epoch() {
 fn a_compute_budget_ends_the_run_sets_its_rate_and_extends_on_resume() {
     let device = Device::flex();
     let dir = tempfile::tempdir().unwrap();
-    let s = setup(Variant::Naive, 60);
-    let data = samples(&s, 3);
-    let train = || {
-        data.chunks(1)
-            .map(|c| Ok::<_, String>(c.to_vec()))
-            .collect::<Vec<_>>()
-    };
+    let (mut trainer, data) = naive_trainer_on_three(&device);
+    let train = || batches_of_one(&data);
     let no_valid = None::<fn() -> Vec<_>>;
     // 0.3 CPU seconds: a fraction of what 1000 epochs take, at least a step.
     let budget = TimeBudget::new(0.005, 0.0, 1e-3, 1e-5).unwrap();
-    let mut trainer = Trainer::new(s.clone(), LossConfig::new(), 1e-3, &device).unwrap();
     trainer.set_budget(Some(budget));
     let reports = trainer
         .fit(1000, |_, _| train(), no_valid, dir.path(), |_| {})
