@@ -153,6 +153,32 @@ fn train_resume_eval_and_drape() {
     let csv = std::fs::read_to_string(per_step.join("metrics.csv")).unwrap();
     assert_eq!(lr(&csv, 1), 1e-3, "{csv}");
     assert!(lr(&csv, 2) > 1e-4 && lr(&csv, 2) < 1e-3, "{csv}");
+    // A compute budget from the command line: 0.01 CPU minutes end a 1000-epoch recipe
+    // long before its last epoch.
+    let budget = tmp.path().join("budget");
+    let budget_recipe = recipe(
+        tmp.path(),
+        "budget",
+        data,
+        "naive",
+        1000,
+        "cosine_to = 1e-4",
+        "",
+    );
+    let log = ok_v(train(&budget_recipe, &budget, &["--minutes", "0.01"]));
+    let csv = std::fs::read_to_string(budget.join("metrics.csv")).unwrap();
+    let rows = csv.lines().count() - 1;
+    let cpu: f64 = csv
+        .lines()
+        .last()
+        .unwrap()
+        .rsplit(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(rows >= 1 && rows < 1000 && cpu >= 0.6, "{csv}\n{log}");
+    assert!(log.contains("CPU min in all"), "{log}");
     let bad = recipe(tmp.path(), "bad", data, "naive", 1, "per_step = true", "");
     let err = fails_v(train(&bad, &per_step, &[]));
     assert!(
@@ -662,12 +688,13 @@ fn train_resumes_an_epoch_stopped_inside() {
     let log = ok_v(run(&stopped, &["--resume"]));
     assert!(log.contains("inside epoch 1, after 1 batches"), "{log}");
     assert!(!mid.exists() && stopped.join("last.garnet").is_file());
-    // The row without its wall time (the fourth column).
+    // The row without its wall time (the fourth column) and CPU time (the last).
     let row = |dir: &Path| -> Vec<String> {
         let csv = std::fs::read_to_string(dir.join("metrics.csv")).unwrap();
         let last = csv.lines().last().unwrap().to_string();
         let mut cells: Vec<String> = last.split(',').map(String::from).collect();
         cells.remove(3);
+        cells.pop();
         cells
     };
     assert_eq!(row(&stopped), row(&whole));
