@@ -240,12 +240,18 @@ pub fn vertex_loss(pred: Tensor<3>, target: Tensor<3>, power: f64) -> Tensor<1> 
 /// Unit face normals `[B,F,3]` of `vertices` `[B,N,3]` with the faces' corner index tensors
 /// (`[F]` each).
 pub fn face_normals(vertices: Tensor<3>, faces: &[Tensor<1, Int>; 3]) -> Tensor<3> {
+    let n = face_cross(vertices, faces);
+    let len = (n.clone().square().sum_dim(2) + SQRT_EPS).sqrt();
+    n / len
+}
+
+/// Each face's `(v1 - v0) x (v2 - v0)` `[B,F,3]` (twice its area along its normal) of
+/// `vertices` `[B,N,3]`.
+fn face_cross(vertices: Tensor<3>, faces: &[Tensor<1, Int>; 3]) -> Tensor<3> {
     let v0 = gather_rows(vertices.clone(), &faces[0]);
     let v1 = gather_rows(vertices.clone(), &faces[1]);
     let v2 = gather_rows(vertices, &faces[2]);
-    let n = (v1 - v0.clone()).cross(v2 - v0, 2);
-    let len = (n.clone().square().sum_dim(2) + SQRT_EPS).sqrt();
-    n / len
+    (v1 - v0.clone()).cross(v2 - v0, 2)
 }
 
 /// L_norm: mean over the B*F faces of `(1 - F^G . F^P)^2`. `pred`, `target` `[B,N,3]`.
@@ -259,10 +265,7 @@ pub fn normal_loss(pred: Tensor<3>, target: Tensor<3>, faces: &[Tensor<1, Int>; 
 /// `sqrt(2 area(F^G)) |F^G - F^P|`, metres. `pred`, `target` `[B,N,3]` metres.
 pub fn tilt_loss(pred: Tensor<3>, target: Tensor<3>, faces: &[Tensor<1, Int>; 3]) -> Tensor<1> {
     let fp = face_normals(pred, faces);
-    let v0 = gather_rows(target.clone(), &faces[0]);
-    let v1 = gather_rows(target.clone(), &faces[1]);
-    let v2 = gather_rows(target, &faces[2]);
-    let cross = (v1 - v0.clone()).cross(v2 - v0, 2).detach();
+    let cross = face_cross(target, faces).detach();
     let twice_area = (cross.clone().square().sum_dim(2) + SQRT_EPS).sqrt();
     let fg = cross / twice_area.clone();
     let turn = ((fp - fg).square().sum_dim(2) + SQRT_EPS).sqrt();

@@ -396,9 +396,7 @@ impl Recipe {
             cosine
         }))
     }
-}
 
-impl Recipe {
     /// The compute budget of `[schedule] minutes` (`None` without one): `lr` for
     /// `warmup_minutes`, then the cosine to `cosine_to` (or `lr` throughout without it).
     pub fn time_budget(&self) -> Result<Option<TimeBudget>> {
