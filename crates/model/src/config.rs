@@ -133,6 +133,12 @@ pub struct GarNetConfig {
     /// which vertex it is looking at whatever the pose. Off in the paper's networks.
     #[config(default = false)]
     pub rest_input: bool,
+    /// Our extension (not in the paper): layer normalisation (learned scale and shift) of the
+    /// global body feature, before the garment stream and the fusion see it, and of the
+    /// global garment feature. Max pooling leaves their scale free, and an unnormalised
+    /// per-sample bias that grows during training is what makes a run diverge at high rates.
+    #[config(default = false)]
+    pub global_norm: bool,
     /// Width of the global garment feature (a shared layer then max pooling over vertices).
     #[config(default = 256)]
     pub garment_global: usize,
@@ -231,7 +237,7 @@ impl GarNetConfig {
     }
 
     /// The network's name in reports: `GarNet-local` (the variant's name), followed by
-    /// ` +contact` and ` +rest` when it has our extensions.
+    /// ` +contact`, ` +rest` and ` +norm` when it has our extensions.
     pub fn method_name(&self) -> String {
         let mut name = format!("GarNet-{}", self.variant.name());
         if self.body_contact {
@@ -239,6 +245,9 @@ impl GarNetConfig {
         }
         if self.rest_input {
             name.push_str(" +rest");
+        }
+        if self.global_norm {
+            name.push_str(" +norm");
         }
         name
     }
@@ -269,8 +278,12 @@ mod tests {
             .with_rest_input(true);
         assert_eq!(both.method_name(), "GarNet-global +contact +rest");
         assert_eq!(
-            both.with_body_contact(false).method_name(),
+            both.clone().with_body_contact(false).method_name(),
             "GarNet-global +rest"
+        );
+        assert_eq!(
+            both.with_global_norm(true).method_name(),
+            "GarNet-global +contact +rest +norm"
         );
     }
 }

@@ -107,6 +107,12 @@ pub struct NetworkRecipe {
     /// [`GarNetConfig::rest_input`] (default false: the paper's inputs).
     #[serde(default)]
     pub rest_input: bool,
+    /// The base M: `fitted` for the surface-anchored warp (bench candidate c).
+    #[serde(default)]
+    pub base: Option<String>,
+    /// [`GarNetConfig::global_norm`] (default false: the paper's network).
+    #[serde(default)]
+    pub global_norm: bool,
     /// [`GarNetConfig::seed`]: the initial parameters' seed.
     #[serde(default)]
     pub seed: u64,
@@ -341,6 +347,7 @@ impl Recipe {
         let mut c = GarNetConfig::new(self.variant()?)
             .with_body_contact(n.body_contact)
             .with_rest_input(n.rest_input)
+            .with_global_norm(n.global_norm)
             .with_seed(n.seed);
         if let Some(v) = n.body_subsample {
             c.body_subsample = v;
