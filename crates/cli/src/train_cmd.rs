@@ -93,57 +93,10 @@ impl TrainArgs {
     }
 }
 
-/// The surface-anchored warp as the network's base M (bench candidate c).
-pub struct FittedBase {
-    model: body::BodyModel,
-    anchors: garment::warp::SurfaceAnchors,
-    template: std::sync::Arc<garment::GarmentTemplate>,
-    skinning: body::Skinning,
-    bodies: std::sync::Mutex<std::collections::HashMap<u32, std::sync::Arc<body::ShapedBody>>>,
-}
-
-impl FittedBase {
-    fn new(split: &GarmentSplit) -> anyhow::Result<Self> {
-        let model = body::BodyModel::load()?;
-        let rest = model.shape(&body::Phenotype::default())?;
-        let template = split.template()?;
-        let anchors = garment::warp::SurfaceAnchors::new(&template.mesh, &rest.mesh)?;
-        Ok(Self {
-            model,
-            anchors,
-            template,
-            skinning: split.data.body_skinning(),
-            bodies: Default::default(),
-        })
-    }
-
-    fn warp(&self, s: &dataset::reader::Sample) -> anyhow::Result<Vec<glam::Vec3>> {
-        let a = &s.arrays;
-        let cached = self.bodies.lock().unwrap().get(&s.record.body).cloned();
-        let shaped = match cached {
-            Some(b) => b,
-            None => {
-                let b = std::sync::Arc::new(
-                    self.model.shape(&body::Phenotype::from_values(&a.phenotype)?)?,
-                );
-                self.bodies.lock().unwrap().insert(s.record.body, b.clone());
-                b
-            }
-        };
-        let pose = body::Pose {
-            root_translation: a.root_translation,
-            rotations: a.rotations.clone(),
-        };
-        Ok(garment::warp::warp_fitted(&self.template, &self.anchors, &shaped, &pose, self.skinning)?.vertices)
-    }
-}
-
 /// A dataset's samples of one garment and split, as the network's training samples.
 pub struct GarmentSplit<'a> {
     data: &'a Dataset,
     topology: BodyTopology,
-    /// The base M when it is not the stored DQS warp.
-    pub fitted: Option<std::sync::Arc<FittedBase>>,
     /// Stored sample indices.
     pub indices: Vec<u64>,
 }
@@ -165,14 +118,7 @@ impl<'a> GarmentSplit<'a> {
             data,
             topology,
             indices,
-            fitted: None,
         })
-    }
-
-    /// Uses the surface-anchored warp as M.
-    pub fn use_fitted(&mut self) -> anyhow::Result<()> {
-        self.fitted = Some(std::sync::Arc::new(FittedBase::new(self)?));
-        Ok(())
     }
 
     /// The garment template the samples share (metres).
@@ -204,12 +150,13 @@ impl<'a> GarmentSplit<'a> {
             let b = b.map_err(|e| e.to_string())?;
             b.into_iter()
                 .map(|s| {
-                    let warped = match &self.fitted {
-                        Some(f) => f.warp(&s).map_err(|e| e.to_string())?,
-                        None => s.arrays.warped,
-                    };
-                    Sample::new(s.arrays.body, &self.topology, warped, Some(s.arrays.draped))
-                        .map_err(|e| format!("sample {}: {e}", s.record.index))
+                    Sample::new(
+                        s.arrays.body,
+                        &self.topology,
+                        s.arrays.warped,
+                        Some(s.arrays.draped),
+                    )
+                    .map_err(|e| format!("sample {}: {e}", s.record.index))
                 })
                 .collect()
         })
@@ -235,13 +182,7 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
     if let Some(n) = recipe.drapes.max_samples {
         train.indices.truncate(n);
     }
-    let mut valid = GarmentSplit::new(&data, "val", garment).ok();
-    if recipe.network.base.as_deref() == Some("fitted") {
-        train.use_fitted()?;
-        if let Some(v) = &mut valid {
-            v.fitted = train.fitted.clone();
-        }
-    }
+    let valid = GarmentSplit::new(&data, "val", garment).ok();
     let out = args
         .out
         .clone()

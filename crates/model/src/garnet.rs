@@ -271,7 +271,11 @@ mod tests {
         let mut fusion = fc(d_vertex, h[0], true) + fc(c.garment_global + cb, h[0], false);
         let (hidden, last) = mlp(h[0], &h[1..]);
         fusion += hidden + fc(last, 3, true);
-        let norm = if c.global_norm { 2 * (cb + c.garment_global) } else { 0 };
+        let norm = if c.global_norm {
+            2 * (cb + c.garment_global)
+        } else {
+            0
+        };
         body + garment + local + fusion + norm
     }
 
@@ -281,7 +285,11 @@ mod tests {
         let mut counts = Vec::new();
         for variant in Variant::ALL {
             let normed = GarNetConfig::tiny(variant).with_global_norm(true);
-            for cfg in [GarNetConfig::new(variant), GarNetConfig::tiny(variant), normed] {
+            for cfg in [
+                GarNetConfig::new(variant),
+                GarNetConfig::tiny(variant),
+                normed,
+            ] {
                 let model = cfg.init(&device).unwrap();
                 assert_eq!(model.variant(), variant);
                 assert_eq!(model.num_params(), expected_params(&cfg), "{variant:?}");

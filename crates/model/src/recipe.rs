@@ -107,9 +107,6 @@ pub struct NetworkRecipe {
     /// [`GarNetConfig::rest_input`] (default false: the paper's inputs).
     #[serde(default)]
     pub rest_input: bool,
-    /// The base M: `fitted` for the surface-anchored warp (bench candidate c).
-    #[serde(default)]
-    pub base: Option<String>,
     /// [`GarNetConfig::global_norm`] (default false: the paper's network).
     #[serde(default)]
     pub global_norm: bool,

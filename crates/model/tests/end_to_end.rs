@@ -262,7 +262,9 @@ fn global_norm_takes_out_the_body_features_scale() {
         let topo = topo.to_device(&device);
         let mut model = s.config.init(&device).unwrap();
         let run = |m: &GarNet| {
-            let t = m.translations(&batch.inputs, batch.warped.clone(), &topo).unwrap();
+            let t = m
+                .translations(&batch.inputs, batch.warped.clone(), &topo)
+                .unwrap();
             t.into_data().to_vec::<f32>().unwrap()
         };
         let before = run(&model);
@@ -274,12 +276,18 @@ fn global_norm_takes_out_the_body_features_scale() {
         (before, run(&model))
     };
     let largest = |(a, b): (Vec<f32>, Vec<f32>)| {
-        a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0f32, f32::max)
+        a.iter()
+            .zip(&b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0f32, f32::max)
     };
     let normed = largest(drapes(true));
     let plain = largest(drapes(false));
     assert!(normed < 1e-6, "with the norm the drape moved {normed} m");
-    assert!(plain > 1e-4, "without the norm the drape moved only {plain} m");
+    assert!(
+        plain > 1e-4,
+        "without the norm the drape moved only {plain} m"
+    );
 }
 
 #[test]
