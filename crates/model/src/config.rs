@@ -135,8 +135,9 @@ pub struct GarNetConfig {
     pub rest_input: bool,
     /// Our extension (not in the paper): layer normalisation (learned scale and shift) of the
     /// global body feature, before the garment stream and the fusion see it, and of the
-    /// global garment feature. Max pooling leaves their scale free, and an unnormalised
-    /// per-sample bias that grows during training is what makes a run diverge at high rates.
+    /// global garment feature. Max pooling leaves their scale free; normalised, they let the
+    /// network train at a learning rate of 1e-3 (docs/findings.md, "The fixed-compute
+    /// benchmark").
     #[config(default = false)]
     pub global_norm: bool,
     /// Width of the global garment feature (a shared layer then max pooling over vertices).
