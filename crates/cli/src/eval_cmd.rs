@@ -39,9 +39,9 @@ pub struct EvalArgs {
     /// out" (the paper's Table 1 has the network's raw output only).
     #[arg(long)]
     pub push_out: bool,
-    /// Also a row per garment of the surface-anchored warp: the template carried onto each
-    /// body's rest shape by its surface anchors (as the simulator grades it), then skinned
-    /// as the dataset's bodies are; a baseline beside DQS.
+    /// Also a row per garment of the surface-anchored M: the template placed on each posed
+    /// body by its surface anchors (where the fitted-start simulator starts, and the M of a
+    /// network with `base = "anchored"`); a baseline beside DQS.
     #[arg(long)]
     pub fitted: bool,
     /// Also write every evaluated drape (the network's, the simulator's, the warped M and

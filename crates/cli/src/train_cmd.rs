@@ -97,6 +97,9 @@ impl TrainArgs {
 pub struct GarmentSplit<'a> {
     data: &'a Dataset,
     topology: BodyTopology,
+    /// The anchors M is placed with when the network's base is anchored (`None`: the
+    /// stored DQS warp).
+    pub anchors: Option<std::sync::Arc<garment::warp::SurfaceAnchors>>,
     /// Stored sample indices.
     pub indices: Vec<u64>,
 }
@@ -117,6 +120,7 @@ impl<'a> GarmentSplit<'a> {
         Ok(Self {
             data,
             topology,
+            anchors: None,
             indices,
         })
     }
@@ -150,13 +154,16 @@ impl<'a> GarmentSplit<'a> {
             let b = b.map_err(|e| e.to_string())?;
             b.into_iter()
                 .map(|s| {
-                    Sample::new(
-                        s.arrays.body,
-                        &self.topology,
-                        s.arrays.warped,
-                        Some(s.arrays.draped),
-                    )
-                    .map_err(|e| format!("sample {}: {e}", s.record.index))
+                    let a = s.arrays;
+                    let warped = match &self.anchors {
+                        Some(anchors) => anchors.place(&geom::TriMesh::new(
+                            a.body.clone(),
+                            self.topology.faces.clone(),
+                        )),
+                        None => a.warped,
+                    };
+                    Sample::new(a.body, &self.topology, warped, Some(a.draped))
+                        .map_err(|e| format!("sample {}: {e}", s.record.index))
                 })
                 .collect()
         })
@@ -182,7 +189,15 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
     if let Some(n) = recipe.drapes.max_samples {
         train.indices.truncate(n);
     }
-    let valid = GarmentSplit::new(&data, "val", garment).ok();
+    let mut valid = GarmentSplit::new(&data, "val", garment).ok();
+    let base = recipe.network_config()?.base;
+    if base != model::Base::Dqs {
+        let anchors = garnet::base_anchors(base, &*train.template()?, &body::BodyModel::load()?)?;
+        train.anchors = anchors.map(std::sync::Arc::new);
+        if let Some(v) = &mut valid {
+            v.anchors = train.anchors.clone();
+        }
+    }
     let out = args
         .out
         .clone()

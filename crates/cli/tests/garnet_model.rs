@@ -210,7 +210,7 @@ fn train_resume_eval_and_drape() {
         "| tshirt | GarNet-local, pushed out |",
         "GarNet-naive",
         "| tshirt | DQS |",
-        "| tshirt | surface-anchored warp |",
+        "| tshirt | surface-anchored M |",
         "simulator / network",
         "## E_dist by motion",
         "| tshirt | GarNet-local | procedural walk |",
@@ -589,12 +589,14 @@ fn train_takes_the_network_widths_from_its_recipe() {
         train(&file, &tmp.path().join(name), &["--max-samples", "2"])
     };
     let default = params(&ok_v(run("default", "")));
-    let narrow = "[network]\nfusion = [16, 8]\nbody_contact = true\nrest_input = true\n";
+    // Narrow, with the contact and rest inputs, and M placed by the surface anchors.
+    let narrow = "[network]\nfusion = [16, 8]\nbody_contact = true\nrest_input = true\n\
+                  base = \"anchored\"\n";
     let log = ok_v(run("narrow", narrow));
     // The recipe's fusion widths and extra inputs: fewer parameters than the default
     // Naive, named with its extensions.
     assert!(
-        log.contains("training GarNet-naive +contact +rest ("),
+        log.contains("training GarNet-naive +contact +rest +anchored ("),
         "{log}"
     );
     assert!(params(&log) < default, "{log}");
@@ -611,7 +613,10 @@ fn train_takes_the_network_widths_from_its_recipe() {
         s(&tmp.path().join("eval")),
     ]);
     let table = std::fs::read_to_string(tmp.path().join("eval/results.md")).unwrap();
-    assert!(table.contains("| GarNet-naive +contact +rest |"), "{table}");
+    assert!(
+        table.contains("| GarNet-naive +contact +rest +anchored |"),
+        "{table}"
+    );
     // The model carries the body's faces, so a drape computes the contact features itself.
     let out = ok(&[
         "drape",
@@ -624,7 +629,10 @@ fn train_takes_the_network_widths_from_its_recipe() {
         "--out",
         s(&tmp.path().join("d.glb")),
     ]);
-    assert!(out.contains("GarNet-naive +contact +rest"), "{out}");
+    assert!(
+        out.contains("GarNet-naive +contact +rest +anchored"),
+        "{out}"
+    );
     let draped = geom::io::read_mesh(tmp.path().join("d.glb")).unwrap();
     assert!(draped.vertices.iter().all(|v| v.is_finite()));
     // An unknown field, a wrong type or an empty width list names the file and the field.
@@ -635,6 +643,11 @@ fn train_takes_the_network_widths_from_its_recipe() {
     );
     let err = fails_v(run("type", "[network]\nfusion = 16\n"));
     assert!(err.contains("type.toml") && err.contains("fusion"), "{err}");
+    let err = fails_v(run("base", "[network]\nbase = \"smpl\"\n"));
+    assert!(
+        err.contains("base.toml") && err.contains("dqs or anchored"),
+        "{err}"
+    );
     let err = fails_v(run("empty", "[network]\nfusion = []\n"));
     assert!(
         err.contains("empty.toml") && err.contains("fusion"),

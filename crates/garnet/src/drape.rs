@@ -3,7 +3,9 @@
 //! A [`GarmentModel`] is one `.garnet` file: the network, the garment template it drapes and
 //! the body points it sees. [`drape`] takes a shaped body and a pose, clears the limbs out of
 //! the body (as the training poses were), poses the body with the skinning the models learned
-//! from, warps each template onto it (dual quaternion skinning: the network's input M), runs
+//! from, warps each template onto it (the network's input M, made as the network learned it:
+//! dual quaternion skinning, or placed on the body's surface by the template's surface
+//! anchors; see [`model::Base`]), runs
 //! the networks and moves the vertices they leave inside the body, or nearer its skin than
 //! the simulator's cloth thickness, out to that distance.
 
@@ -12,12 +14,13 @@ use std::time::Instant;
 
 use anyhow::{anyhow, bail, Context};
 use body::clearance::{clear_limbs, ClearanceOptions};
+use body::BodyModel;
 use body::{Pose, RigidTransform, ShapedBody, Skinning};
 use burn::prelude::Device;
-use garment::warp::warp;
+use garment::warp::{warp, SurfaceAnchors};
 use garment::GarmentTemplate;
 use geom::TriMesh;
-use model::Draper;
+use model::{Base, Draper};
 
 /// How far from the skin the push-out looks for garment vertices, metres: on the
 /// benchmark's test split 6 cm left 0.17-0.36% of the vertices inside the body, 3 cm
@@ -35,21 +38,36 @@ pub struct GarmentModel {
     path: PathBuf,
     draper: Draper,
     template: GarmentTemplate,
+    /// The anchors M is placed with ([`Base::Anchored`] networks only).
+    anchors: Option<SurfaceAnchors>,
 }
 
 impl GarmentModel {
     /// Loads the model file at `path` (`.garnet`) onto `device` (`Device::flex()` for the
     /// CPU). Fails, naming the file, when it is missing, damaged, of another format, or
-    /// carries no garment template.
+    /// carries no garment template. A network whose M is anchored ([`Base::Anchored`])
+    /// also loads the body model, to anchor the template on its template body.
     pub fn load(path: &Path, device: &Device) -> anyhow::Result<Self> {
         let draper =
             Draper::load(path, device).with_context(|| format!("loading {}", path.display()))?;
         let template = checkpoint_template(&draper, path)?;
+        let anchors = match draper.setup().config.base {
+            Base::Dqs => None,
+            base => base_anchors(base, &template, &BodyModel::load()?)
+                .with_context(|| format!("{}: anchoring the garment", path.display()))?,
+        };
         Ok(GarmentModel {
             path: path.to_path_buf(),
             draper,
             template,
+            anchors,
         })
+    }
+
+    /// The network's input M on `posed_body` (`[V]`, metres) when the network places it by
+    /// surface anchors ([`Base::Anchored`]); `None` when M is skinned from the bones.
+    pub fn anchored_m(&self, posed_body: &TriMesh) -> Option<Vec<glam::Vec3>> {
+        self.anchors.as_ref().map(|a| a.place(posed_body))
     }
 
     /// The file it was loaded from.
@@ -77,6 +95,27 @@ impl GarmentModel {
         let name = &self.draper.setup().body_skinning;
         Skinning::from_name(name)
             .with_context(|| format!("{}: unknown body skinning '{name}'", self.path.display()))
+    }
+}
+
+/// The anchors a network's `base` places M with: `None` for [`Base::Dqs`]; for
+/// [`Base::Anchored`] the anchors of `template` (`[N]` vertices, metres) on its template
+/// body, shaped by `bodies` from the template's phenotype (as the dataset's simulator
+/// anchors it).
+pub fn base_anchors(
+    base: Base,
+    template: &GarmentTemplate,
+    bodies: &BodyModel,
+) -> anyhow::Result<Option<SurfaceAnchors>> {
+    match base {
+        Base::Dqs => Ok(None),
+        Base::Anchored => {
+            let template_body = bodies.shape(&template.body_phenotype)?;
+            Ok(Some(SurfaceAnchors::new(
+                &template.mesh,
+                &template_body.mesh,
+            )?))
+        }
     }
 }
 
@@ -118,8 +157,8 @@ pub struct DrapedGarment {
     pub kind: String,
     /// The draped mesh: `[N]` vertices (metres, the body's frame) and the template's faces.
     pub mesh: TriMesh,
-    /// The network's input M: the template warped onto the posed body by DQS, `[N]`
-    /// vertices (metres).
+    /// The network's input M: the template warped onto the posed body as the network
+    /// learned it (DQS, or placed by surface anchors), `[N]` vertices (metres).
     pub warped: Vec<glam::Vec3>,
     /// What the time went to, ms.
     pub timings: DrapeTimings,
@@ -130,7 +169,7 @@ pub struct DrapedGarment {
 /// Times of one garment's drape, milliseconds.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct DrapeTimings {
-    /// The DQS warp of the template (the network's input M).
+    /// The warp of the template (the network's input M).
     pub warp_ms: f64,
     /// The network's forward pass.
     pub network_ms: f64,
@@ -213,7 +252,7 @@ pub fn drape(
 
 /// Drapes every model's garment on a body the caller posed ([`PosedBody`]; posed as the
 /// models' training bodies were, see [`GarmentModel::body_skinning`]): M is each template
-/// skinned by DQS with the bones' placements. No limb clearance (the pose is not known);
+/// skinned by DQS with the bones' placements, or placed on the body by its surface anchors. No limb clearance (the pose is not known);
 /// the push-out as `push_out` says. Fails on a vertex or bone count that is not the body
 /// model's, a non-finite input, or models that disagree.
 pub fn drape_posed(
@@ -274,8 +313,9 @@ pub fn drape_posed(
     Ok(drape_on(models, &body, warp_m, push_out)?.0)
 }
 
-/// The networks of `models` on `body` (posed, `[V]`), each with its M from `warp_m`, then
-/// the push-out when asked; the collider's build time (ms) with it.
+/// The networks of `models` on `body` (posed, `[V]`), each with its M placed on `body` by
+/// its anchors or, for a DQS network, from `warp_m`; then the push-out when asked; the
+/// collider's build time (ms) with it.
 fn drape_on(
     models: &[GarmentModel],
     body: &TriMesh,
@@ -288,7 +328,10 @@ fn drape_on(
             .iter()
             .map(|m| {
                 let start = Instant::now();
-                let warped = warp_m(m)?;
+                let warped = match m.anchored_m(body) {
+                    Some(placed) => placed,
+                    None => warp_m(m)?,
+                };
                 let warp_ms = start.elapsed().as_secs_f64() * 1e3;
                 let start = Instant::now();
                 let draped = m

@@ -34,7 +34,8 @@ pub mod shipped;
 
 pub use burn::prelude::Device;
 pub use drape::{
-    drape, drape_posed, Drape, DrapeOptions, DrapeTimings, DrapedGarment, GarmentModel, PosedBody,
+    base_anchors, drape, drape_posed, Drape, DrapeOptions, DrapeTimings, DrapedGarment,
+    GarmentModel, PosedBody,
 };
 pub use eval::{evaluate, EvalOptions, EvalReport};
 pub use motion::{drape_motion, FrameRange, Motion, MotionOptions};

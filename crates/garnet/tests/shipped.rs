@@ -125,3 +125,65 @@ fn a_body_posed_by_the_caller_drapes_as_its_shape_and_pose() {
         .to_string()
         .contains("joint 3"));
 }
+
+/// A network whose base is anchored gets M placed on the posed body by the template's
+/// surface anchors, not skinned by DQS, and is named for it.
+#[test]
+fn an_anchored_network_gets_its_m_placed_by_the_surface_anchors() {
+    use garnet::model::{load_checkpoint, save_checkpoint, Base};
+    let device = Device::flex();
+    let shipped = shipped_models_dir().join("jeans-naive.garnet");
+    let ck = load_checkpoint(&shipped).unwrap();
+    let mut setup = ck.setup.clone();
+    setup.config.base = Base::Anchored;
+    let dir = tempfile::tempdir().unwrap();
+    let anchored_path = dir.path().join("jeans-anchored.garnet");
+    let net = ck.model(&device).unwrap();
+    save_checkpoint(
+        &anchored_path,
+        &net,
+        None,
+        &setup,
+        &ck.loss,
+        &ck.state,
+        ck.recipe.as_ref(),
+    )
+    .unwrap();
+    let dqs = GarmentModel::load(&shipped, &device).unwrap();
+    let anchored = GarmentModel::load(&anchored_path, &device).unwrap();
+    assert!(
+        anchored.method_name().ends_with(" +anchored"),
+        "{}",
+        anchored.method_name()
+    );
+    assert!(!dqs.method_name().contains("anchored"));
+    let bodies = BodyModel::load().unwrap();
+    // A heavier body than the template's: the anchors carry the garment over its girth.
+    let heavy = Phenotype {
+        weight: 0.8,
+        ..Phenotype::default()
+    };
+    let target = bodies.shape(&heavy).unwrap();
+    let mut walks =
+        garnet::body::pose::ProceduralPoseGenerator::new(2, garnet::body::pose::PoseKind::Walk);
+    let pose = garnet::body::self_contact::sample_valid_pose(&target, &mut walks, 200).unwrap();
+    let opts = DrapeOptions {
+        clear_limbs: false,
+        push_out: false,
+    };
+    let anchors = garnet::base_anchors(Base::Anchored, anchored.template(), &bodies)
+        .unwrap()
+        .unwrap();
+    let a = drape(&[anchored], &target, &pose, opts).unwrap();
+    let d = drape(&[dqs], &target, &pose, opts).unwrap();
+    assert_eq!(a.garments[0].warped, anchors.place(&a.body));
+    let apart = a.garments[0]
+        .warped
+        .iter()
+        .zip(&d.garments[0].warped)
+        .map(|(p, q)| p.distance(*q))
+        .sum::<f32>()
+        / a.garments[0].warped.len() as f32;
+    assert!(apart > 1e-3, "M moved {apart} m");
+    assert_ne!(a.garments[0].mesh.vertices, d.garments[0].mesh.vertices);
+}

@@ -59,6 +59,39 @@ impl Variant {
     }
 }
 
+/// What the network's input M (the base its translations are added to) is.
+#[derive(Config, Debug, Copy, PartialEq, Eq, Hash)]
+pub enum Base {
+    /// The paper's M: the garment template skinned onto the posed body by dual quaternions,
+    /// driven by the joints only.
+    Dqs,
+    /// The garment template placed on the posed body's surface by its surface anchors (each
+    /// vertex keeps its offset in the frame of its closest template-body surface point): the
+    /// state the fitted-start simulator starts from, so M follows girth as well as pose.
+    Anchored,
+}
+
+impl Base {
+    /// Lower-case name: `dqs` or `anchored`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Base::Dqs => "dqs",
+            Base::Anchored => "anchored",
+        }
+    }
+
+    /// Parses [`Base::name`] (case-insensitive).
+    pub fn parse(s: &str) -> Result<Base> {
+        match s.to_ascii_lowercase().as_str() {
+            "dqs" => Ok(Base::Dqs),
+            "anchored" => Ok(Base::Anchored),
+            _ => Err(ModelError::InvalidInput(format!(
+                "unknown base {s:?} (dqs or anchored)"
+            ))),
+        }
+    }
+}
+
 /// GarNet's architecture: variant and widths (channel counts). `init` builds the network.
 ///
 /// Every list is the output widths of the consecutive per-point layers of one block; each
@@ -140,6 +173,10 @@ pub struct GarNetConfig {
     /// benchmark").
     #[config(default = false)]
     pub global_norm: bool,
+    /// Our extension (not in the paper): what M is. [`Base::Dqs`] is the paper's; whoever
+    /// drapes with the network builds M as this says (see `garnet::base_m`).
+    #[config(default = "Base::Dqs")]
+    pub base: Base,
     /// Width of the global garment feature (a shared layer then max pooling over vertices).
     #[config(default = 256)]
     pub garment_global: usize,
@@ -238,7 +275,7 @@ impl GarNetConfig {
     }
 
     /// The network's name in reports: `GarNet-local` (the variant's name), followed by
-    /// ` +contact`, ` +rest` and ` +norm` when it has our extensions.
+    /// ` +contact`, ` +rest`, ` +norm` and ` +anchored` when it has our extensions.
     pub fn method_name(&self) -> String {
         let mut name = format!("GarNet-{}", self.variant.name());
         if self.body_contact {
@@ -249,6 +286,9 @@ impl GarNetConfig {
         }
         if self.global_norm {
             name.push_str(" +norm");
+        }
+        if self.base == Base::Anchored {
+            name.push_str(" +anchored");
         }
         name
     }
@@ -282,9 +322,13 @@ mod tests {
             both.clone().with_body_contact(false).method_name(),
             "GarNet-global +rest"
         );
+        let both = both.with_global_norm(true);
+        assert_eq!(both.method_name(), "GarNet-global +contact +rest +norm");
         assert_eq!(
-            both.with_global_norm(true).method_name(),
-            "GarNet-global +contact +rest +norm"
+            both.with_base(Base::Anchored).method_name(),
+            "GarNet-global +contact +rest +norm +anchored"
         );
+        assert_eq!(Base::parse("Anchored").unwrap(), Base::Anchored);
+        assert_eq!(Base::parse(Base::Dqs.name()).unwrap(), Base::Dqs);
     }
 }

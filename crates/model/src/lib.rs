@@ -68,7 +68,7 @@ pub mod trainer;
 pub use alloc::tune_allocator;
 pub use batch::{Batch, BodyTopology, InputSpec, KnownBodies, NetInputs, Sample};
 pub use checkpoint::{load_checkpoint, save_checkpoint, Checkpoint, ModelSetup, TrainState};
-pub use config::{GarNetConfig, Variant};
+pub use config::{Base, GarNetConfig, Variant};
 pub use drape::Draper;
 pub use error::{ModelError, Result};
 pub use frame::CanonicalFrame;

@@ -37,7 +37,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::config::{GarNetConfig, Variant};
+use crate::config::{Base, GarNetConfig, Variant};
 use crate::error::{ModelError, Result};
 use crate::loss::{LossConfig, NormalLoss, VertexLoss};
 use crate::schedule::{CosineSchedule, TimeBudget};
@@ -110,6 +110,9 @@ pub struct NetworkRecipe {
     /// [`GarNetConfig::global_norm`] (default false: the paper's network).
     #[serde(default)]
     pub global_norm: bool,
+    /// [`GarNetConfig::base`] by its [`Base::name`] (`dqs`, the paper's, when left out).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub base: Option<String>,
     /// [`GarNetConfig::seed`]: the initial parameters' seed.
     #[serde(default)]
     pub seed: u64,
@@ -346,6 +349,9 @@ impl Recipe {
             .with_rest_input(n.rest_input)
             .with_global_norm(n.global_norm)
             .with_seed(n.seed);
+        if let Some(v) = &n.base {
+            c.base = Base::parse(v)?;
+        }
         if let Some(v) = n.body_subsample {
             c.body_subsample = v;
         }
@@ -485,6 +491,10 @@ max_strain_pct = 5.0
             (
                 EXAMPLE.replace("vertex = 2.0", "vertex = 2.0\nnormal_loss = \"cos\""),
                 "L_norm",
+            ),
+            (
+                EXAMPLE.replace("[network]", "[network]\nbase = \"smpl\""),
+                "dqs or anchored",
             ),
             (EXAMPLE.replace("epochs = 30", "epochs = 0"), "epochs"),
             (

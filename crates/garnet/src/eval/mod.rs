@@ -18,7 +18,7 @@ use dataset::{Dataset, DrapeFilter};
 use geom::metrics::{face_normal_angles, precision_curve, vertex_distances};
 use geom::{Bvh, TriMesh};
 use glam::Vec3;
-use model::Draper;
+use model::{Base, Draper};
 use render::plot::{Chart, Series};
 use serde::Serialize;
 
@@ -32,9 +32,9 @@ use save::{save_folders, DrapeSaver, SavedDrape};
 pub struct EvalOutputs<'a> {
     /// Also the network's drapes pushed out of the body as `garnet drape` does.
     pub push_out: bool,
-    /// Also a row of the surface-anchored warp (`garment::warp::warp_fitted`: the template
-    /// carried onto the target's rest shape by its surface anchors, then skinned as the
-    /// dataset's bodies are): the base the simulator grades its garments by, as a baseline.
+    /// Also a row of the surface-anchored M (the template placed on the posed body by its
+    /// surface anchors, [`model::Base::Anchored`]): where the fitted-start simulator starts
+    /// its drapes, as a baseline.
     pub fitted: bool,
     /// Write every drape and its errors into this folder (see [`save`]).
     pub save_drapes: Option<&'a Path>,
@@ -171,7 +171,7 @@ pub struct ModelEvaluation {
     /// The network's drapes pushed out of the body as `garnet drape` does, when asked.
     pushed: Option<Row>,
     dqs: Row,
-    /// The surface-anchored warp of the same samples, when asked.
+    /// The surface-anchored M of the same samples, when asked.
     fitted: Option<Row>,
     timing: Timing,
     by_motion: Vec<MotionRow>,
@@ -303,11 +303,12 @@ impl EvalData {
             Errors::default(),
             Errors::default(),
         );
-        let anchors = outputs
-            .fitted
-            .then(|| garment::warp::SurfaceAnchors::new(&template.mesh, &self.body_rest.mesh))
-            .transpose()?;
-        let skinning = data.body_skinning();
+        let base =
+            crate::drape::base_anchors(draper.setup().config.base, &template, &self.body_model)?;
+        let anchors = match outputs.fitted {
+            true => crate::drape::base_anchors(Base::Anchored, &template, &self.body_model)?,
+            false => None,
+        };
         let mut by_motion = ByMotion::default();
         let mut saver = outputs
             .save_drapes
@@ -323,8 +324,10 @@ impl EvalData {
         for batch in Batches::new(data, &indices, opts) {
             for s in batch? {
                 let a = &s.arrays;
+                let body_mesh = TriMesh::new(a.body.clone(), self.body_faces.clone());
                 let start = Instant::now();
-                let mut pred = draper.drape(&a.body, &a.warped)?;
+                let placed = base.as_ref().map(|b| b.place(&body_mesh));
+                let mut pred = draper.drape(&a.body, placed.as_ref().unwrap_or(&a.warped))?;
                 net_ms.push(start.elapsed().as_secs_f64() * 1e3);
                 // The DQS warp of the same pose (its cost does not depend on the shape).
                 let pose = Pose {
@@ -335,7 +338,6 @@ impl EvalData {
                 garment::warp::warp(&template, &self.body_rest, &pose, Skinning::Dqs)?;
                 dqs_ms.push(start.elapsed().as_secs_f64() * 1e3);
                 sim_s.extend(self.sim_times.get(&s.record.index));
-                let body_mesh = TriMesh::new(a.body.clone(), self.body_faces.clone());
                 // With the push-out, its collider's BVH serves the inside counts too.
                 let collider = push_out
                     .then(|| sim::BodyCollider::new(&body_mesh, push_out_gap()))
@@ -351,12 +353,7 @@ impl EvalData {
                 let net_cm = net.add(&a.draped, &pred, faces, body)?;
                 let dqs_cm = dqs.add(&a.draped, &a.warped, faces, body)?;
                 if let Some(anchors) = &anchors {
-                    let target = self
-                        .body_model
-                        .shape(&Phenotype::from_values(&a.phenotype)?)?;
-                    let m =
-                        garment::warp::warp_fitted(&template, anchors, &target, &pose, skinning)?;
-                    fitted.add(&a.draped, &m.vertices, faces, body)?;
+                    fitted.add(&a.draped, &anchors.place(&body_mesh), faces, body)?;
                 }
                 if let Some(saver) = &mut saver {
                     saver.save(&SavedDrape {
@@ -387,7 +384,7 @@ impl EvalData {
             dqs: dqs.row(&garment, "DQS"),
             fitted: outputs
                 .fitted
-                .then(|| fitted.row(&garment, "surface-anchored warp")),
+                .then(|| fitted.row(&garment, "surface-anchored M")),
             timing: Timing {
                 garment: garment.clone(),
                 method,
@@ -421,7 +418,7 @@ pub struct EvalOptions {
     pub max_samples: Option<usize>,
     /// Also rows of each network's drapes after the push-out (`garnet drape`'s default).
     pub push_out: bool,
-    /// Also a row per garment of the surface-anchored warp (see [`EvalOutputs::fitted`]).
+    /// Also a row per garment of the surface-anchored M (see [`EvalOutputs::fitted`]).
     pub fitted: bool,
     /// Also write every evaluated drape and its errors under this folder, one folder per
     /// model (see [`save`]).
