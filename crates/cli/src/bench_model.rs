@@ -5,6 +5,7 @@
 use body::BodyModel;
 use body::Skinning;
 use burn::prelude::Device;
+use garment::warp::SurfaceAnchors;
 use model::bench::{bench_forward, bench_train_step, Timing};
 use model::{Draper, GarNetConfig, ModelSetup, Variant};
 
@@ -177,13 +178,24 @@ fn same_drape(
         let setup = ModelSetup::new(config, case.template.mesh.clone(), body)?
             .with_body_faces(sim.body.faces.clone())?;
         let name = setup.config.method_name();
+        // An anchored network's M is placed on the posed body per drape, timed with it.
+        let anchors = match setup.config.base {
+            model::Base::Dqs => None,
+            model::Base::Anchored => Some(SurfaceAnchors::new(
+                &case.template.mesh,
+                &case.template_body.mesh,
+            )?),
+        };
         let draper = Draper::new(setup.config.init(device)?, setup, device)?;
-        let t = Timing::measure(runs, || draper.drape(body, &warped.vertices).map(|_| ()))?;
+        let net = || match &anchors {
+            Some(a) => draper.drape(body, &a.place(&sim.body)),
+            None => draper.drape(body, &warped.vertices),
+        };
+        let t = Timing::measure(runs, || net().map(|_| ()))?;
         // As `garnet drape` runs it: the network beside the build of the body's collider,
         // then the push-out of the vertices left inside the body.
         let with_push = Timing::measure(runs, || {
-            let (pred, collider) =
-                beside_push_out_collider(Some(&sim.body), || draper.drape(body, &warped.vertices));
+            let (pred, collider) = beside_push_out_collider(Some(&sim.body), net);
             let collider = collider.map_err(|e| model::ModelError::InvalidInput(e.to_string()))?;
             let mut g = pred?;
             if let Some((c, _)) = collider {

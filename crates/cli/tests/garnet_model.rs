@@ -797,16 +797,18 @@ fn bench_model_reports_every_variant_against_the_dqs_warp() {
 
 /// `--recipe` times networks of a recipe's widths and inputs: the same-drape rows compare
 /// the paper's GarNet-Local with the recipe's (here wider, with the body-contact and
-/// template-vertex inputs), and the parameter counts are the recipe's.
+/// template-vertex inputs, M placed by the surface anchors), and the parameter counts are
+/// the recipe's.
 #[test]
 fn bench_model_times_the_networks_of_a_recipe() {
     let tmp = tempfile::tempdir().unwrap();
-    let network = "[network]\nconv_width = 48\nbody_contact = true\nrest_input = true\n";
+    let network = "[network]\nconv_width = 48\nbody_contact = true\nrest_input = true\n\
+                   base = \"anchored\"\n";
     let file = recipe(tmp.path(), "net", Path::new("d"), "local", 1, "", network);
     let args = |config: &Path| small_bench_model(&["--recipe", s(config)]);
     let out = ok(&as_str(&args(&file)));
     assert!(out.contains("net.toml"), "{out}");
-    for name in ["GarNet-local", "GarNet-local +contact +rest"] {
+    for name in ["GarNet-local", "GarNet-local +contact +rest +anchored"] {
         assert!(
             out.contains(&format!("same drape: {name} with the push-out")),
             "{out}"
