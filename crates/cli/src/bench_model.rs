@@ -5,7 +5,6 @@
 use body::BodyModel;
 use body::Skinning;
 use burn::prelude::Device;
-use garment::warp::SurfaceAnchors;
 use model::bench::{bench_forward, bench_train_step, Timing};
 use model::{Draper, GarNetConfig, ModelSetup, Variant};
 
@@ -79,7 +78,7 @@ pub fn bench_model(
         }
     }
     if simulator {
-        same_drape(&reference, runs, &device, &networks)?;
+        same_drape(&reference, &body_model, runs, &device, &networks)?;
     }
     for &n in sizes {
         for variant in Variant::ALL {
@@ -160,8 +159,10 @@ impl BenchNetworks {
 
 /// GarNet-Local (the time does not depend on the trained values) and the simulator on the
 /// same drape: the benchmark's T-shirt on its posed body. Prints a row each and their ratio.
+/// `bodies` shapes the template body an anchored network's anchors are made on.
 fn same_drape(
     case: &TshirtCase,
+    bodies: &BodyModel,
     runs: usize,
     device: &Device,
     networks: &BenchNetworks,
@@ -179,13 +180,7 @@ fn same_drape(
             .with_body_faces(sim.body.faces.clone())?;
         let name = setup.config.method_name();
         // An anchored network's M is placed on the posed body per drape, timed with it.
-        let anchors = match setup.config.base {
-            model::Base::Dqs => None,
-            model::Base::Anchored => Some(SurfaceAnchors::new(
-                &case.template.mesh,
-                &case.template_body.mesh,
-            )?),
-        };
+        let anchors = garnet::base_anchors(setup.config.base, &case.template, bodies)?;
         let draper = Draper::new(setup.config.init(device)?, setup, device)?;
         let net = || match &anchors {
             Some(a) => draper.drape(body, &a.place(&sim.body)),

@@ -174,7 +174,7 @@ pub struct GarNetConfig {
     #[config(default = false)]
     pub global_norm: bool,
     /// Our extension (not in the paper): what M is. [`Base::Dqs`] is the paper's; whoever
-    /// drapes with the network builds M as this says (see `garnet::base_m`).
+    /// drapes with the network builds M as this says (see `garnet::base_anchors`).
     #[config(default = "Base::Dqs")]
     pub base: Base,
     /// Width of the global garment feature (a shared layer then max pooling over vertices).
