@@ -329,7 +329,7 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
             )
         });
         bar.suspend(|| eprintln!(
-            "epoch {} ({:.1} s, {:.1} CPU min in all, lr {:.2e}): loss {:.3e} (vertex {:.3e} pen {:.3e} norm {:.3e} bend {:.3e}), grad norm {:.3e}{v}{}",
+            "epoch {} ({:.1} s, {:.1} CPU min in all, lr {:.2e}): loss {:.3e} (vertex {:.3e} pen {:.3e} norm {:.3e} bend {:.3e} curvature {:.3e}), grad norm {:.3e}{v}{}",
             r.epoch,
             r.seconds,
             r.train_cpu_s / 60.0,
@@ -339,6 +339,7 @@ pub fn run(args: &TrainArgs) -> anyhow::Result<()> {
             r.train.pen,
             r.train.norm,
             r.train.bend,
+            r.train.curvature,
             r.grad_norm,
             if r.is_best { " *best" } else { "" }
         ))

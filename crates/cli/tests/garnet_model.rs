@@ -128,7 +128,7 @@ fn train_resume_eval_and_drape() {
         .lines()
         .next()
         .unwrap()
-        .ends_with(",train_grad_norm,train_cpu_s"));
+        .ends_with(",train_grad_norm,train_cpu_s,train_curvature,val_curvature"));
     let lr = |csv: &str, row: usize| -> f64 {
         let line = csv.lines().nth(row).unwrap();
         line.split(',').nth(2).unwrap().parse().unwrap()
@@ -173,7 +173,7 @@ fn train_resume_eval_and_drape() {
         .last()
         .unwrap()
         .rsplit(',')
-        .next()
+        .nth(2)
         .unwrap()
         .parse()
         .unwrap();

@@ -88,7 +88,7 @@ pub fn model_card(c: &CardInputs) -> anyhow::Result<String> {
     }
     md += &format!(
         "- progress: {} epochs, {} steps, last learning rate {:.1e}; best validation E_dist {}\n\
-         - loss: {} L_vertex ({}) + {} L_pen + {} L_norm ({}) + {} L_bend, lengths in cm, d_tol {} m\n\n",
+         - loss: {} L_vertex ({}) + {} L_pen + {} L_norm ({}) + {} L_bend + {} L_curv, lengths in cm, d_tol {} m\n\n",
         state.epoch,
         state.step,
         state.lr,
@@ -101,6 +101,7 @@ pub fn model_card(c: &CardInputs) -> anyhow::Result<String> {
         loss.norm,
         loss.normal_loss.name(),
         loss.bend,
+        loss.curvature,
         loss.d_tol,
     );
     md += &metrics_section(c);

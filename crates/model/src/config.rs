@@ -166,13 +166,6 @@ pub struct GarNetConfig {
     /// which vertex it is looking at whatever the pose. Off in the paper's networks.
     #[config(default = false)]
     pub rest_input: bool,
-    /// Our extension (not in the paper): layer normalisation (learned scale and shift) of the
-    /// global body feature, before the garment stream and the fusion see it, and of the
-    /// global garment feature. Max pooling leaves their scale free; normalised, they let the
-    /// network train at a learning rate of 1e-3 (docs/findings.md, "The fixed-compute
-    /// benchmark").
-    #[config(default = false)]
-    pub global_norm: bool,
     /// Our extension (not in the paper): what M is. [`Base::Dqs`] is the paper's; whoever
     /// drapes with the network builds M as this says (see `garnet::base_anchors`).
     #[config(default = "Base::Dqs")]
@@ -284,9 +277,6 @@ impl GarNetConfig {
         if self.rest_input {
             name.push_str(" +rest");
         }
-        if self.global_norm {
-            name.push_str(" +norm");
-        }
         if self.base == Base::Anchored {
             name.push_str(" +anchored");
         }
@@ -322,11 +312,9 @@ mod tests {
             both.clone().with_body_contact(false).method_name(),
             "GarNet-global +rest"
         );
-        let both = both.with_global_norm(true);
-        assert_eq!(both.method_name(), "GarNet-global +contact +rest +norm");
         assert_eq!(
             both.with_base(Base::Anchored).method_name(),
-            "GarNet-global +contact +rest +norm +anchored"
+            "GarNet-global +contact +rest +anchored"
         );
         assert_eq!(Base::parse("Anchored").unwrap(), Base::Anchored);
         assert_eq!(Base::parse(Base::Dqs.name()).unwrap(), Base::Dqs);

@@ -1,7 +1,6 @@
 //! GarNet: body stream + garment stream + fusion; predicts per-vertex translations of the
 //! warped garment M and returns `G = M + T` (paper eq. 1).
 
-use burn::nn::{LayerNorm, LayerNormConfig};
 use burn::prelude::*;
 
 use crate::batch::NetInputs;
@@ -25,8 +24,6 @@ pub struct GarNet {
     pub local: Option<LocalPool>,
     /// Fusion network.
     pub fusion: Fusion,
-    /// Layer normalisation of the global features (see [`GarNetConfig::global_norm`]).
-    pub global_norm: Option<GlobalNorm>,
     /// Input and output length unit, metres (see [`GarNetConfig::input_scale`]).
     pub input_scale: f32,
     /// Centre subtracted from input positions `[3]`, metres.
@@ -35,15 +32,6 @@ pub struct GarNet {
     pub body_contact: bool,
     /// Whether the garment stream takes the template's vertices ([`GarNetConfig::rest_input`]).
     pub rest_input: bool,
-}
-
-/// Layer normalisation of the two per-sample global features.
-#[derive(Module, Debug)]
-pub struct GlobalNorm {
-    /// On the global body feature `[B,Cb]`.
-    pub body: LayerNorm,
-    /// On the global garment feature `[B,garment_global]`.
-    pub garment: LayerNorm,
 }
 
 impl GarNetConfig {
@@ -67,16 +55,11 @@ impl GarNetConfig {
         }
         let d_global = self.garment_global + self.body_feature_width();
         let fusion = Fusion::new(d_vertex, d_global, &self.fusion, &mut init, device);
-        let global_norm = self.global_norm.then(|| GlobalNorm {
-            body: LayerNormConfig::new(self.body_feature_width()).init(device),
-            garment: LayerNormConfig::new(self.garment_global).init(device),
-        });
         Ok(GarNet {
             body,
             garment,
             local,
             fusion,
-            global_norm,
             input_scale: self.input_scale,
             input_centre: self.input_centre.clone(),
             body_contact: self.body_contact,
@@ -160,16 +143,10 @@ impl GarNet {
             extra.push((r.clone() - centre) / unit);
         }
         extra.extend(inputs.contact.clone());
-        let mut body_features = self.body.forward(body);
-        if let Some(norm) = &self.global_norm {
-            body_features.global = norm.body.forward(body_features.global);
-        }
-        let mut garment = self
+        let body_features = self.body.forward(body);
+        let garment = self
             .garment
             .forward(warped, body_features.global.clone(), extra, topo);
-        if let Some(norm) = &self.global_norm {
-            garment.global = norm.garment.forward(garment.global);
-        }
         let mut per_vertex = vec![garment.points];
         if let Some(p) = garment.patches {
             per_vertex.push(p);
@@ -271,12 +248,7 @@ mod tests {
         let mut fusion = fc(d_vertex, h[0], true) + fc(c.garment_global + cb, h[0], false);
         let (hidden, last) = mlp(h[0], &h[1..]);
         fusion += hidden + fc(last, 3, true);
-        let norm = if c.global_norm {
-            2 * (cb + c.garment_global)
-        } else {
-            0
-        };
-        body + garment + local + fusion + norm
+        body + garment + local + fusion
     }
 
     #[test]
@@ -284,12 +256,7 @@ mod tests {
         let device = Device::flex();
         let mut counts = Vec::new();
         for variant in Variant::ALL {
-            let normed = GarNetConfig::tiny(variant).with_global_norm(true);
-            for cfg in [
-                GarNetConfig::new(variant),
-                GarNetConfig::tiny(variant),
-                normed,
-            ] {
+            for cfg in [GarNetConfig::new(variant), GarNetConfig::tiny(variant)] {
                 let model = cfg.init(&device).unwrap();
                 assert_eq!(model.variant(), variant);
                 assert_eq!(model.num_params(), expected_params(&cfg), "{variant:?}");

@@ -40,6 +40,7 @@ pub mod body_stream;
 pub mod checkpoint;
 pub mod config;
 pub mod contact;
+pub mod curvature_loss;
 pub mod dense_rows;
 pub mod drape;
 pub mod epoch_progress;

@@ -15,10 +15,15 @@
 //!   where `s_f = sqrt(2 area)` of the label's face: how far a face's corners move when it
 //!   tilts (a tilt of angle t moves them about `s_f t`), a length like the other terms';
 //! - `L_bend = 1/|N2| sum_{i,k} | |G^P_i - G^P_k| - |G^G_i - G^G_k| |` over vertex pairs two
-//!   edges apart (centimetres).
+//!   edges apart (centimetres);
+//! - `L_curv`, GarNet++'s curvature term, off by default (weight 0): how each vertex's
+//!   neighbourhood spreads along the label's principal axes, prediction against label
+//!   (centimetres; [`crate::curvature_loss`]).
 //!
 //! Every term is averaged over the batch too. Each weight can be set to 0 for ablations; the
-//! terms are computed and reported either way.
+//! first four terms are computed and reported either way, L_curv (which costs a 3x3
+//! eigendecomposition per label vertex on the CPU) only when it is weighted, else reported
+//! as 0.
 
 use burn::prelude::*;
 use burn::tensor::activation::relu;
@@ -26,6 +31,7 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 use crate::batch::Batch;
+use crate::curvature_loss::curvature_loss;
 use crate::error::{ModelError, Result};
 use crate::tensors::{gather_rows, index_tensor, read_f32, read_points, vec_tensor};
 use crate::topology::TopologyTensors;
@@ -49,6 +55,9 @@ pub struct LossConfig {
     /// Weight of L_bend, lambda_bend (0.5).
     #[config(default = 0.5)]
     pub bend: f64,
+    /// Weight of L_curv, GarNet++'s curvature term (0: off, as in GarNet).
+    #[config(default = 0.0)]
+    pub curvature: f64,
     /// d_tol: L_pen only counts vertices closer than this to their target (metres, 0.05).
     #[config(default = 0.05)]
     pub d_tol: f64,
@@ -155,6 +164,9 @@ pub struct LossTerms {
     pub norm: f32,
     /// L_bend, loss units (cm).
     pub bend: f32,
+    /// L_curv, loss units (cm); 0 when its weight is 0.
+    #[serde(default)]
+    pub curvature: f32,
 }
 
 impl LossTerms {
@@ -166,6 +178,7 @@ impl LossTerms {
             pen: self.pen * w,
             norm: self.norm * w,
             bend: self.bend * w,
+            curvature: self.curvature * w,
         }
     }
 }
@@ -181,6 +194,7 @@ impl std::ops::Add for LossTerms {
             pen: self.pen + o.pen,
             norm: self.norm + o.norm,
             bend: self.bend + o.bend,
+            curvature: self.curvature + o.curvature,
         }
     }
 }
@@ -198,10 +212,12 @@ pub struct LossTensors {
     pub norm: Tensor<1>,
     /// L_bend `[1]`.
     pub bend: Tensor<1>,
+    /// L_curv `[1]` (0 when unweighted).
+    pub curvature: Tensor<1>,
 }
 
 impl LossTensors {
-    /// Reads the five values back (one transfer).
+    /// Reads the six values back (one transfer).
     pub fn values(&self) -> Result<LossTerms> {
         let all = Tensor::cat(
             vec![
@@ -210,6 +226,7 @@ impl LossTensors {
                 self.pen.clone().detach(),
                 self.norm.clone().detach(),
                 self.bend.clone().detach(),
+                self.curvature.clone().detach(),
             ],
             0,
         );
@@ -220,6 +237,7 @@ impl LossTensors {
             pen: v[2],
             norm: v[3],
             bend: v[4],
+            curvature: v[5],
         })
     }
 }
@@ -380,6 +398,11 @@ pub fn garnet_loss(
         NormalLoss::Paper => normal_loss(pred.clone(), target.clone(), &topo.faces),
         NormalLoss::Tilt => tilt_loss(pred.clone(), target.clone(), &topo.faces) * unit,
     };
+    let curvature = if cfg.curvature > 0.0 {
+        curvature_loss(pred.clone(), target.clone(), targets, topo)? * unit
+    } else {
+        Tensor::zeros([1], &device)
+    };
     let bend = bending_loss(pred, target, &topo.bend_pairs);
     let vertex = vertex * unit.powf(cfg.vertex_loss.power());
     let pen = pen * unit;
@@ -389,6 +412,7 @@ pub fn garnet_loss(
         (cfg.pen, &pen),
         (cfg.norm, &norm),
         (cfg.bend, &bend),
+        (cfg.curvature, &curvature),
     ];
     let mut total: Option<Tensor<1>> = None;
     for (w, term) in weighted {
@@ -407,6 +431,7 @@ pub fn garnet_loss(
         pen,
         norm,
         bend,
+        curvature,
     })
 }
 
@@ -605,15 +630,19 @@ mod tests {
     /// Central differences of the full loss against its autodiff gradient, for every
     /// coordinate of a prediction on a 4x4 grid with penetrating, non-penetrating, masked
     /// and unmasked vertices (all kinks at least a few h away), with the paper's squared
-    /// L_vertex and with the distance itself.
+    /// L_vertex, with the distance itself, and with L_curv weighted.
     #[test]
     fn full_loss_gradient_matches_finite_differences() {
-        for kind in [VertexLoss::Squared, VertexLoss::Distance] {
-            full_loss_gradient_check(kind);
+        for (kind, curvature) in [
+            (VertexLoss::Squared, 0.0),
+            (VertexLoss::Distance, 0.0),
+            (VertexLoss::Distance, 1.0),
+        ] {
+            full_loss_gradient_check(kind, curvature);
         }
     }
 
-    fn full_loss_gradient_check(vertex_loss: VertexLoss) {
+    fn full_loss_gradient_check(vertex_loss: VertexLoss, curvature: f64) {
         let plain = Device::flex();
         let ad = plain.clone().autodiff();
         let mesh = geom::TriMesh::grid(4, 4, 0.1);
@@ -663,7 +692,9 @@ mod tests {
             contact_faces: None,
             rest_input: None,
         };
-        let cfg = LossConfig::new().with_vertex_loss(vertex_loss);
+        let cfg = LossConfig::new()
+            .with_vertex_loss(vertex_loss)
+            .with_curvature(curvature);
         let loss_at = |p: &[Vec3]| -> f64 {
             let b = Batch::new(std::slice::from_ref(&sample), &topo, &spec, &plain).unwrap();
             let tt = topo.to_device(&plain);
@@ -681,8 +712,8 @@ mod tests {
         let g = crate::tensors::read_f32(p_ad.grad(&grads).unwrap()).unwrap();
         let terms = loss.values().unwrap();
         assert!(
-            terms.pen > 0.0,
-            "the example must exercise L_pen: {terms:?}"
+            terms.pen > 0.0 && (curvature == 0.0 || terms.curvature > 0.1),
+            "the example must exercise L_pen (and L_curv when weighted): {terms:?}"
         );
         let h = 2e-4f32;
         // The loss is summed in f32, so a central difference moves in steps of the total's
@@ -704,7 +735,7 @@ mod tests {
                 worst = worst.max(off / (1e-3 + ad.abs()));
                 assert!(
                     off <= 2e-4 + 2e-2 * ad.abs(),
-                    "{vertex_loss:?}, vertex {i} coord {c}: finite difference {fd}, autodiff {ad} \
+                    "{vertex_loss:?}, L_curv {curvature}, vertex {i} coord {c}: finite difference {fd}, autodiff {ad} \
                      (differences resolve {quantum})"
                 );
             }

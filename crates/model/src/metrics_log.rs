@@ -3,11 +3,11 @@
 //! ```text
 //! epoch,step,lr,seconds,train_samples,train_total,train_vertex,train_pen,train_norm,
 //! train_bend,val_samples,val_total,val_vertex,val_pen,val_norm,val_bend,val_e_dist_cm,
-//! val_e_norm_deg,best,train_grad_norm,train_cpu_s
+//! val_e_norm_deg,best,train_grad_norm,train_cpu_s,train_curvature,val_curvature
 //! ```
 //!
 //! Loss terms in the loss's units (vertex cm^2, or cm with `VertexLoss::Distance`; pen and
-//! bend cm; norm none);
+//! bend and curvature cm, curvature 0 when unweighted; norm none, or cm as a tilt);
 //! the `val_*` fields are empty for an epoch without validation; `best` is 1 when the epoch
 //! wrote `best.garnet`; `train_grad_norm` is the epoch's mean joint gradient norm before
 //! clipping; `train_cpu_s` the CPU time the run's training steps have
@@ -23,7 +23,7 @@ use crate::trainer::Validation;
 /// The CSV header line.
 pub const HEADER: &str = "epoch,step,lr,seconds,train_samples,train_total,train_vertex,\
 train_pen,train_norm,train_bend,val_samples,val_total,val_vertex,val_pen,val_norm,val_bend,\
-val_e_dist_cm,val_e_norm_deg,best,train_grad_norm,train_cpu_s";
+val_e_dist_cm,val_e_norm_deg,best,train_grad_norm,train_cpu_s,train_curvature,val_curvature";
 
 /// One epoch's row.
 #[derive(Clone, Debug, PartialEq)]
@@ -82,7 +82,13 @@ impl MetricsRow {
             None => s.push_str(",,,,,,,,"),
         }
         s.push_str(if self.is_best { "1," } else { "0," });
-        s.push_str(&format!("{},{:.1}", self.grad_norm, self.train_cpu_s));
+        s.push_str(&format!(
+            "{},{:.1},{},",
+            self.grad_norm, self.train_cpu_s, t.curvature
+        ));
+        if let Some(v) = &self.validation {
+            s.push_str(&format!("{}", v.terms.curvature));
+        }
         s
     }
 }
@@ -150,6 +156,7 @@ mod tests {
                 pen: 0.0,
                 norm: 0.1,
                 bend: 0.2,
+                curvature: 0.05,
             },
             train_samples: 8,
             grad_norm: 2.5,
@@ -181,8 +188,8 @@ mod tests {
         assert!(lines.iter().all(|l| l.split(',').count() == cols));
         assert!(lines[1].starts_with("1,10,0.001,1.500,8,0.5,0.25,0,0.1,0.2,2,"));
         assert!(lines[2].starts_with("2,20,"));
-        assert!(lines[2].ends_with(",1.25,9.5,1,2.5,12.3"));
-        assert!(row(4, false).to_csv().ends_with(",,,,,,,,0,2.5,12.3"));
+        assert!(lines[2].ends_with(",1.25,9.5,1,2.5,12.3,0.05,0"));
+        assert!(row(4, false).to_csv().ends_with(",,,,,,,,0,2.5,12.3,0.05,"));
     }
 
     #[test]

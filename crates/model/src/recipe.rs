@@ -12,8 +12,9 @@
 //! body_contact = true
 //! rest_input = true
 //!
-//! [loss]                      # weights of the four terms; L_vertex squared or the distance
+//! [loss]                      # weights of the terms; L_vertex squared or the distance
 //! vertex = 1.0
+//! curvature = 0.0             # GarNet++'s L_curv (off)
 //! vertex_loss = "squared"
 //! normal_loss = "paper"       # or "tilt": L_norm in centimetres, linear in the angle
 //!
@@ -107,9 +108,6 @@ pub struct NetworkRecipe {
     /// [`GarNetConfig::rest_input`] (default false: the paper's inputs).
     #[serde(default)]
     pub rest_input: bool,
-    /// [`GarNetConfig::global_norm`] (default false: the paper's network).
-    #[serde(default)]
-    pub global_norm: bool,
     /// [`GarNetConfig::base`] by its [`Base::name`] (`dqs`, the paper's, when left out).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub base: Option<String>,
@@ -130,6 +128,8 @@ pub struct LossRecipe {
     pub norm: f64,
     /// Weight of L_bend (0.5).
     pub bend: f64,
+    /// Weight of L_curv, GarNet++'s curvature term (0: off).
+    pub curvature: f64,
     /// `squared` (the paper's) or `distance` (see [`VertexLoss`]).
     pub vertex_loss: String,
     /// `paper` (the paper's) or `tilt` (see [`NormalLoss`]).
@@ -144,6 +144,7 @@ impl Default for LossRecipe {
             pen: paper.pen,
             norm: paper.norm,
             bend: paper.bend,
+            curvature: paper.curvature,
             vertex_loss: paper.vertex_loss.name().into(),
             normal_loss: paper.normal_loss.name().into(),
         }
@@ -347,7 +348,6 @@ impl Recipe {
         let mut c = GarNetConfig::new(self.variant()?)
             .with_body_contact(n.body_contact)
             .with_rest_input(n.rest_input)
-            .with_global_norm(n.global_norm)
             .with_seed(n.seed);
         if let Some(v) = &n.base {
             c.base = Base::parse(v)?;
@@ -387,6 +387,7 @@ impl Recipe {
             .with_pen(l.pen)
             .with_norm(l.norm)
             .with_bend(l.bend)
+            .with_curvature(l.curvature)
             .with_vertex_loss(VertexLoss::parse(&l.vertex_loss)?)
             .with_normal_loss(NormalLoss::parse(&l.normal_loss)?))
     }

@@ -32,6 +32,7 @@ impl LossConfig {
             self.pen,
             self.norm,
             self.bend,
+            self.curvature,
             self.d_tol,
             self.pen_push,
         ];
@@ -40,7 +41,7 @@ impl LossConfig {
                 "loss weights and constants must be finite and >= 0: {self:?}"
             )));
         }
-        if self.vertex + self.pen + self.norm + self.bend == 0.0 {
+        if self.vertex + self.pen + self.norm + self.bend + self.curvature == 0.0 {
             return Err(ModelError::InvalidInput("every loss weight is 0".into()));
         }
         Ok(())

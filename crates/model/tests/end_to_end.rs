@@ -247,49 +247,6 @@ fn drapes_on_the_host_match_the_tensor_ops() {
     }
 }
 
-/// With `global_norm`, the global body feature reaches the network only through its layer
-/// norm: scaling the body stream's last layer (so every point-wise body feature and their
-/// max) leaves GarNet-Global's drape unchanged; without it the drape moves.
-#[test]
-fn global_norm_takes_out_the_body_features_scale() {
-    let device = Device::flex();
-    let drapes = |global_norm: bool| {
-        let (body, _) = model::synthetic::ellipsoid_body(N_BODY);
-        let cfg = GarNetConfig::tiny(Variant::Global).with_global_norm(global_norm);
-        let s = ModelSetup::new(cfg, tube_garment(80), &body).unwrap();
-        let topo = GarmentTopology::from_mesh(&s.template).unwrap();
-        let batch = Batch::new(&samples(&s, 2), &topo, &s.input_spec(), &device).unwrap();
-        let topo = topo.to_device(&device);
-        let mut model = s.config.init(&device).unwrap();
-        let run = |m: &GarNet| {
-            let t = m
-                .translations(&batch.inputs, batch.warped.clone(), &topo)
-                .unwrap();
-            t.into_data().to_vec::<f32>().unwrap()
-        };
-        let before = run(&model);
-        let last = model.body.mlp2.layers.last_mut().unwrap();
-        let w = last.weight.val() * 3.0;
-        last.weight = burn::module::Param::from_tensor(w);
-        let b = last.bias.as_ref().unwrap().val() * 3.0;
-        last.bias = Some(burn::module::Param::from_tensor(b));
-        (before, run(&model))
-    };
-    let largest = |(a, b): (Vec<f32>, Vec<f32>)| {
-        a.iter()
-            .zip(&b)
-            .map(|(x, y)| (x - y).abs())
-            .fold(0.0f32, f32::max)
-    };
-    let normed = largest(drapes(true));
-    let plain = largest(drapes(false));
-    assert!(normed < 1e-6, "with the norm the drape moved {normed} m");
-    assert!(
-        plain > 1e-4,
-        "without the norm the drape moved only {plain} m"
-    );
-}
-
 #[test]
 fn extended_network_takes_its_inputs_and_only_it() {
     let device = Device::flex();
@@ -679,7 +636,7 @@ fn a_compute_budget_ends_the_run_sets_its_rate_and_extends_on_resume() {
         .last()
         .unwrap()
         .rsplit(',')
-        .next()
+        .nth(2)
         .unwrap()
         .parse()
         .unwrap();
@@ -730,8 +687,8 @@ fn trainer_writes_checkpoints_and_metrics_and_resumes() {
     assert_eq!(reports[0].lr, 1e-3);
     assert!((reports[1].lr - schedule.lr(1)).abs() < 1e-15);
     assert!(reports.iter().all(|r| r.grad_norm > 0.0));
-    assert!(text.lines().nth(1).unwrap().ends_with(&format!(
-        ",{},{:.1}",
+    assert!(text.lines().nth(1).unwrap().contains(&format!(
+        ",{},{:.1},",
         reports[0].grad_norm, reports[0].train_cpu_s
     )));
 
