@@ -35,14 +35,26 @@ use crate::topology::TopologyTensors;
 /// where a neighbourhood has no spread along an axis; changes a 1 mm deviation by 5e-7 m.
 const VAR_EPS: f64 = 1e-12;
 
-/// `[B*N*9]` the unit principal axes of every label's neighbourhoods, row-major as
-/// `[B,N,3,3]` (row j of vertex i's block is its j-th axis `e_ij`). `targets` `[B][N]`
-/// metres; `ring` the template's neighbourhoods. Fails when a target has not N vertices or a
-/// neighbourhood's covariance has no eigendecomposition (a non-finite label).
-pub fn principal_axes(targets: &[Vec<Vec3>], ring: &HostRing) -> Result<Vec<f32>> {
+/// The labels' principal axes and their spread along them, from one eigendecomposition.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LabelAxes {
+    /// `[B*N*9]` unit axes, row-major as `[B,N,3,3]` (row j of vertex i's block is its j-th
+    /// axis `e_ij`).
+    pub axes: Vec<f32>,
+    /// `[B*N*3]` the label's standard deviation along each axis, `sqrt(lambda_ij + eps)`
+    /// (metres), as `[B,N,1,3]`.
+    pub spread: Vec<f32>,
+}
+
+/// The principal axes of every label's neighbourhoods and the label's spread along them.
+/// `targets` `[B][N]` metres; `ring` the template's neighbourhoods. Fails when a target has
+/// not N vertices or a neighbourhood's covariance has no eigendecomposition (a non-finite
+/// label).
+pub fn principal_axes(targets: &[Vec<Vec3>], ring: &HostRing) -> Result<LabelAxes> {
     let k = ring.k;
     let n = ring.ring.len() / k.max(1);
     let mut axes = Vec::with_capacity(targets.len() * n * 9);
+    let mut spread = Vec::with_capacity(targets.len() * n * 3);
     for target in targets {
         if target.len() != n {
             return Err(ModelError::InvalidInput(format!(
@@ -74,15 +86,16 @@ pub fn principal_axes(targets: &[Vec<Vec3>], ring: &HostRing) -> Result<Vec<f32>
                     "L_curv: no principal axes at label vertex {i} ({e:?})"
                 ))
             })?;
-            let u = eig.U();
+            let (u, lambda) = (eig.U(), eig.S().column_vector());
             for j in 0..3 {
                 for a in 0..3 {
                     axes.push(u[(a, j)] as f32);
                 }
+                spread.push((lambda[j].max(0.0) + VAR_EPS).sqrt() as f32);
             }
         }
     }
-    Ok(axes)
+    Ok(LabelAxes { axes, spread })
 }
 
 /// The standard deviations `[B,N,1,3]` of each neighbourhood of `v` `[B,N,3]` (metres)
@@ -98,23 +111,19 @@ fn spread_along(v: Tensor<3>, axes: Tensor<4>, topo: &TopologyTensors) -> Tensor
     ((along.square() * w).sum_dim(2) + VAR_EPS).sqrt()
 }
 
-/// L_curv (module docs), metres: `pred`, `target` `[B,N,3]` metres, `targets` the same
-/// labels on the host (`[B][N]`).
+/// L_curv (module docs), metres: `pred` `[B,N,3]` metres, `targets` its labels on the host
+/// (`[B][N]`), whose spread comes with their axes from [`principal_axes`].
 pub fn curvature_loss(
     pred: Tensor<3>,
-    target: Tensor<3>,
     targets: &[Vec<Vec3>],
     topo: &TopologyTensors,
 ) -> Result<Tensor<1>> {
     let [b, n, _] = pred.dims();
-    let axes = vec_tensor(
-        principal_axes(targets, &topo.host_ring)?,
-        [b, n, 3, 3],
-        &pred.device(),
-    );
-    let sp = spread_along(pred, axes.clone(), topo);
-    let sg = spread_along(target, axes, topo).detach();
-    Ok((sp - sg).abs().mean())
+    let label = principal_axes(targets, &topo.host_ring)?;
+    let device = pred.device();
+    let axes = vec_tensor(label.axes, [b, n, 3, 3], &device);
+    let sg = vec_tensor(label.spread, [b, n, 1, 3], &device);
+    Ok((spread_along(pred, axes, topo) - sg).abs().mean())
 }
 
 #[cfg(test)]
@@ -138,13 +147,7 @@ mod tests {
     fn loss(pred: &[Vec3], target: &[Vec3], topo: &GarmentTopology) -> f32 {
         let device = Device::flex();
         let tt = topo.to_device(&device);
-        let l = curvature_loss(
-            points_tensor(&[pred], &device),
-            points_tensor(&[target], &device),
-            &[target.to_vec()],
-            &tt,
-        )
-        .unwrap();
+        let l = curvature_loss(points_tensor(&[pred], &device), &[target.to_vec()], &tt).unwrap();
         read_scalar(l).unwrap()
     }
 
@@ -186,21 +189,25 @@ mod tests {
         label[0].z = 0.01;
         let device = Device::flex();
         let tt = topo.to_device(&device);
-        let axes = principal_axes(&[label.clone()], &tt.host_ring).unwrap();
+        let LabelAxes { axes, spread: sg } =
+            principal_axes(&[label.clone()], &tt.host_ring).unwrap();
         // Vertex 0's least-spread axis (faer sorts eigenvalues up: the first) is +-z.
         assert!((axes[2].abs() - 1.0).abs() < 1e-5, "{:?}", &axes[..9]);
-        let sp = spread_along(
-            points_tensor(&[&p], &device),
-            vec_tensor(axes.clone(), [1, 5, 3, 3], &device),
-            &tt,
+        let along = |v: &[Vec3]| {
+            let t = spread_along(
+                points_tensor(&[v], &device),
+                vec_tensor(axes.clone(), [1, 5, 3, 3], &device),
+                &tt,
+            );
+            crate::tensors::read_f32(t).unwrap()
+        };
+        let sp = along(&p);
+        // The label's spread from its eigenvalues is its spread measured along its axes.
+        let measured = along(&label);
+        assert!(
+            sg.iter().zip(&measured).all(|(a, b)| (a - b).abs() < 1e-6),
+            "{sg:?} {measured:?}"
         );
-        let sg = spread_along(
-            points_tensor(&[&label], &device),
-            vec_tensor(axes, [1, 5, 3, 3], &device),
-            &tt,
-        );
-        let sp = crate::tensors::read_f32(sp).unwrap();
-        let sg = crate::tensors::read_f32(sg).unwrap();
         assert!(
             sp[0] < 2e-6 && (sg[0] - 0.004).abs() < 1e-6,
             "{sp:?} {sg:?}"

@@ -399,7 +399,7 @@ pub fn garnet_loss(
         NormalLoss::Tilt => tilt_loss(pred.clone(), target.clone(), &topo.faces) * unit,
     };
     let curvature = if cfg.curvature > 0.0 {
-        curvature_loss(pred.clone(), target.clone(), targets, topo)? * unit
+        curvature_loss(pred.clone(), targets, topo)? * unit
     } else {
         Tensor::zeros([1], &device)
     };
