@@ -22,7 +22,8 @@ pub struct EvalArgs {
     /// Trained model files (any garments and variants).
     #[arg(long = "model", value_name = "CKPT", required = true, num_args = 1..)]
     pub models: Vec<PathBuf>,
-    /// Output folder: results.md, results.json, precision_dist.png, precision_norm.png.
+    /// Output folder: results.md, results.json, precision_dist.png, precision_norm.png (and
+    /// drapes.png with `--pictures`).
     #[arg(long, default_value = "out/eval")]
     pub out: PathBuf,
     /// Evaluate at most this many samples per garment.
@@ -55,6 +56,14 @@ pub struct EvalArgs {
     /// three drapes in 3D, coloured by each vertex's distance to the simulator's drape.
     #[arg(long)]
     pub html: bool,
+    /// The row name of each model in the tables, in the order of `--model` (one per model),
+    /// in place of its method name: e.g. the loss terms of an ablation's rows.
+    #[arg(long = "label", value_name = "NAME", num_args = 1..)]
+    pub labels: Vec<String>,
+    /// Also draw, per garment, one drape (the first model's drape of median E_dist) by the
+    /// simulator and by every model, on the body, into `drapes.png` in the output folder.
+    #[arg(long)]
+    pub pictures: bool,
 }
 
 /// Runs `garnet eval`.
@@ -65,6 +74,8 @@ pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
         push_out: args.push_out,
         fitted: args.fitted,
         save_drapes: args.save_drapes.clone(),
+        labels: args.labels.clone(),
+        pictures: args.pictures,
     };
     let report = garnet::evaluate(
         &args.data,

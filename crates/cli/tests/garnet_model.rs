@@ -226,6 +226,34 @@ fn train_resume_eval_and_drape() {
         assert!(eval.join(f).is_file(), "{f}");
     }
     check_saved_drapes(&eval.join("drapes").join("local-best"), &report);
+    // Rows named by the caller, and the same drape drawn by both models beside the
+    // simulator's.
+    let named = tmp.path().join("eval-named");
+    let naive_best = naive.join("best.garnet");
+    let model_args = ["--model", s(&best), s(&naive_best)];
+    let mut args = vec!["eval", "--data", s(data), "--out", s(&named), "--pictures"];
+    args.extend(model_args);
+    args.extend(["--label", "all four terms", "no L_bend"]);
+    let report = ok(&args);
+    for row in [
+        "| tshirt | all four terms |",
+        "| tshirt | no L_bend |",
+        "drapes.png",
+    ] {
+        assert!(report.contains(row), "{row} missing:\n{report}");
+    }
+    let sheet = render::Image::from_png(named.join("drapes.png")).unwrap();
+    assert!(
+        sheet.width > 3 * 200 && sheet.height > 400,
+        "{}x{}",
+        sheet.width,
+        sheet.height
+    );
+    let mut args = vec!["eval", "--data", s(data), "--out", s(&named)];
+    args.extend(model_args);
+    args.extend(["--label", "only one"]);
+    let err = fails(&args);
+    assert!(err.contains("1 labels for 2 models"), "{err}");
 
     // Export: the network without the optimiser state, and its model card.
     let shipped = tmp.path().join("models").join("tshirt-local.garnet");

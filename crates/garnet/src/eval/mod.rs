@@ -5,6 +5,7 @@
 //! JSON (naming the dataset's spec and its hash) and two charts ([`EvalReport::write`]).
 
 pub mod motion;
+pub mod pictures;
 pub mod save;
 
 use std::collections::{BTreeSet, HashMap};
@@ -25,6 +26,7 @@ use serde::Serialize;
 use crate::drape::{checkpoint_template, push_out_gap, PUSH_OUT_WITHIN};
 use crate::drapes::{check_body_skinning, keep_drapes};
 use motion::{ByMotion, MotionRow};
+use pictures::KeptDrapes;
 use save::{save_folders, DrapeSaver, SavedDrape};
 
 /// What [`EvalData::evaluate`] makes besides the network's and the DQS warp's rows.
@@ -38,6 +40,8 @@ pub struct EvalOutputs<'a> {
     pub fitted: bool,
     /// Write every drape and its errors into this folder (see [`save`]).
     pub save_drapes: Option<&'a Path>,
+    /// Keep every drape of the network for the pictures (see [`pictures`]).
+    pub keep_drapes: bool,
 }
 
 /// One row of Table 1 and its curves.
@@ -175,6 +179,8 @@ pub struct ModelEvaluation {
     fitted: Option<Row>,
     timing: Timing,
     by_motion: Vec<MotionRow>,
+    /// The network's drapes, when kept for the pictures.
+    kept: Option<KeptDrapes>,
 }
 
 impl ModelEvaluation {
@@ -187,6 +193,18 @@ impl ModelEvaluation {
     /// Median network time per drape (ms) and median simulator time of the same samples (s).
     pub fn times(&self) -> (f64, Option<f64>) {
         (self.timing.network_ms, self.timing.simulator_s)
+    }
+
+    /// Names this model's rows `method` (not the DQS row): a label of the caller's.
+    fn set_method(&mut self, method: &str) {
+        self.net.method = method.into();
+        if let Some(p) = &mut self.pushed {
+            p.method = format!("{method}, pushed out");
+        }
+        self.timing.method = method.into();
+        for m in &mut self.by_motion {
+            m.set_method(method);
+        }
     }
 
     /// Appends ` (model)` to the method name of this model's rows (not of the DQS row).
@@ -310,6 +328,7 @@ impl EvalData {
             false => None,
         };
         let mut by_motion = ByMotion::default();
+        let mut kept = outputs.keep_drapes.then(KeptDrapes::default);
         let mut saver = outputs
             .save_drapes
             .map(|dir| DrapeSaver::new(dir, faces, &self.body_faces))
@@ -366,6 +385,9 @@ impl EvalData {
                         errors: [net_cm, net.last_norm_deg(), dqs_cm],
                     })?;
                 }
+                if let Some(k) = &mut kept {
+                    k.push(s.record.index, &pred, net_cm);
+                }
                 if let Some(c) = &collider {
                     c.push_out(&mut pred, PUSH_OUT_WITHIN, push_out_gap());
                     pushed.add(&a.draped, &pred, faces, body)?;
@@ -394,6 +416,7 @@ impl EvalData {
                 simulator_s: (!sim_s.is_empty()).then(|| median(sim_s)),
             },
             garment,
+            kept,
         })
     }
 }
@@ -423,6 +446,12 @@ pub struct EvalOptions {
     /// Also write every evaluated drape and its errors under this folder, one folder per
     /// model (see [`save`]).
     pub save_drapes: Option<PathBuf>,
+    /// `[models]` the row name of each model in the tables, in place of its method (or
+    /// empty: the method names, with the model file where two models share one).
+    pub labels: Vec<String>,
+    /// Also draw one drape per garment by every model beside the simulator's
+    /// (`drapes.png`, see [`pictures`]).
+    pub pictures: bool,
 }
 
 /// Evaluates the models at `models` (any garments and variants) on `split` of the dataset
@@ -434,6 +463,13 @@ pub fn evaluate(
     opts: &EvalOptions,
     device: &burn::prelude::Device,
 ) -> anyhow::Result<EvalReport> {
+    if !opts.labels.is_empty() && opts.labels.len() != models.len() {
+        return Err(anyhow!(
+            "{} labels for {} models: give one label per model, in the models' order",
+            opts.labels.len(),
+            models.len()
+        ));
+    }
     let data = EvalData::open(data)?;
     let save_dirs = opts
         .save_drapes
@@ -450,11 +486,22 @@ pub fn evaluate(
                 push_out: opts.push_out,
                 fitted: opts.fitted,
                 save_drapes: save_dirs.as_ref().map(|d| d[i].as_path()),
+                keep_drapes: opts.pictures,
             },
             device,
         )?);
     }
-    name_repeated_methods(&mut evaluations, models);
+    if opts.labels.is_empty() {
+        name_repeated_methods(&mut evaluations, models);
+    } else {
+        for (e, label) in evaluations.iter_mut().zip(&opts.labels) {
+            e.set_method(label);
+        }
+    }
+    let pictures = match opts.pictures {
+        true => pictures::draw(&data, &evaluations)?,
+        false => None,
+    };
     let mut report = EvalReport {
         split: split.to_string(),
         dataset: data.id(),
@@ -462,6 +509,7 @@ pub fn evaluate(
         rows: Vec::new(),
         timings: Vec::new(),
         motions: Vec::new(),
+        pictures,
     };
     let mut dqs_done: BTreeSet<String> = BTreeSet::new();
     for e in evaluations {
@@ -495,6 +543,9 @@ pub struct EvalReport {
     /// E_dist by motion.
     #[serde(rename = "by_motion")]
     motions: Vec<MotionRow>,
+    /// One drape per garment by every model (`drapes.png`), when asked.
+    #[serde(skip)]
+    pictures: Option<render::Image>,
 }
 
 impl EvalReport {
@@ -568,6 +619,10 @@ fn markdown(report: &EvalReport) -> String {
     md += &motion::markdown(motions);
     md += "\nPrecision curves: precision_dist.png (share of vertices within a distance of the \
            simulated drape), precision_norm.png (share of faces within an angle of its normal).\n";
+    if report.pictures.is_some() {
+        md += "\nPictures: drapes.png, per garment the simulator's drape of the sample of median \
+               E_dist among the first model's drapes, then every model's drape of it.\n";
+    }
     md
 }
 
@@ -622,9 +677,13 @@ fn write_reports(out: &Path, report: &EvalReport) -> anyhow::Result<()> {
         60.0,
     )
     .draw(&series(|r| &r.norm_curve, norm_thresholds()));
-    for (img, name) in [(dist, "precision_dist.png"), (norm, "precision_norm.png")] {
+    let pictures = report.pictures.iter().map(|p| (p, "drapes.png"));
+    for (img, name) in [(&dist, "precision_dist.png"), (&norm, "precision_norm.png")]
+        .into_iter()
+        .chain(pictures)
+    {
         let p = out.join(name);
-        img.save_png(&p)
+        geom::io::write_bytes_atomic(&p, &img.encode_png()?)
             .with_context(|| format!("writing {}", p.display()))?;
     }
     Ok(())

@@ -30,6 +30,11 @@ pub struct MotionRow {
 }
 
 impl MotionRow {
+    /// Names the row's method `method`.
+    pub fn set_method(&mut self, method: &str) {
+        self.method = method.into();
+    }
+
     /// Appends `suffix` to the method name.
     pub fn add_to_method(&mut self, suffix: &str) {
         self.method.push_str(suffix);
